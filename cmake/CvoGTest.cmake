@@ -1,0 +1,28 @@
+# GoogleTest from an installed package, else built from sources (a bare GPU machine has none:
+# carry /usr/src/googletest there and point CVO_GTEST_SOURCE_DIR at it).
+find_package(GTest QUIET)
+if(NOT TARGET GTest::gtest_main)
+  if(EXISTS "${CVO_GTEST_SOURCE_DIR}/CMakeLists.txt")
+    set(INSTALL_GTEST OFF CACHE BOOL "" FORCE)
+    set(BUILD_GMOCK OFF CACHE BOOL "" FORCE)
+    add_subdirectory(${CVO_GTEST_SOURCE_DIR} ${CMAKE_BINARY_DIR}/googletest EXCLUDE_FROM_ALL)
+    add_library(GTest::gtest_main ALIAS gtest_main)
+  else()
+    message(FATAL_ERROR "GoogleTest not found: install libgtest-dev or set CVO_GTEST_SOURCE_DIR")
+  endif()
+endif()
+include(GoogleTest)
+
+# cvo_add_gtest(name source... LIBS lib...)
+function(cvo_add_gtest name)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  add_executable(${name} ${ARG_UNPARSED_ARGUMENTS})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE CVO_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/test/data")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+  add_dependencies(tests ${name})
+endfunction()
+
+if(NOT TARGET tests)
+  add_custom_target(tests)
+endif()

@@ -1,0 +1,76 @@
+#include "cvo_odometry/tools/command_line.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace cvo {
+
+CommandLine::CommandLine(int argc, char** argv, const std::set<std::string>& options,
+                         const std::set<std::string>& flags) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + arg + "'");
+    const std::string name = arg.substr(2);
+    if (flags.count(name)) {
+      values_[name] = "1";
+    } else if (options.count(name)) {
+      if (i + 1 >= argc) throw std::invalid_argument("option --" + name + " needs a value");
+      values_[name] = argv[++i];
+    } else {
+      throw std::invalid_argument("unknown option --" + name);
+    }
+  }
+}
+
+bool CommandLine::has(const std::string& name) const { return values_.count(name) > 0; }
+
+std::string CommandLine::get(const std::string& name, const std::string& fallback) const {
+  auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+std::string CommandLine::require(const std::string& name) const {
+  if (!has(name)) throw std::invalid_argument("missing required option --" + name);
+  return get(name);
+}
+
+double CommandLine::getDouble(const std::string& name, double fallback) const {
+  if (!has(name)) return fallback;
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(get(name), &used);
+    if (used == get(name).size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw std::invalid_argument("--" + name + " expects a number, got '" + get(name) + "'");
+}
+
+int CommandLine::getInt(const std::string& name, int fallback) const {
+  if (!has(name)) return fallback;
+  try {
+    std::size_t used = 0;
+    const int v = std::stoi(get(name), &used);
+    if (used == get(name).size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw std::invalid_argument("--" + name + " expects an integer, got '" + get(name) + "'");
+}
+
+std::vector<double> CommandLine::getDoubleList(const std::string& name,
+                                               const std::vector<double>& fallback) const {
+  if (!has(name)) return fallback;
+  std::vector<double> values;
+  std::stringstream ss(get(name));
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      values.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--" + name + " expects comma-separated numbers, got '" +
+                                  get(name) + "'");
+    }
+  }
+  return values;
+}
+
+}  // namespace cvo
