@@ -16,7 +16,9 @@ Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
   return W;
 }
 
-Eigen::Vector3d vee(const Eigen::Matrix3d& W) { return {W(2, 1), W(0, 2), W(1, 0)}; }
+Eigen::Vector3d vee(const Eigen::Matrix3d& W) {
+  return {W(2, 1), W(0, 2), W(1, 0)};
+}
 
 Eigen::Matrix3d expSO3(const Eigen::Vector3d& omega) {
   const double theta2 = omega.squaredNorm();
@@ -49,8 +51,10 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
   if (M_PI - theta > 1e-3) {
     return axis_sin * (theta / std::sin(theta));
   }
-  // Near pi sin(theta) vanishes: take the axis from the symmetric part, R + R^T = 2 cos I + 2(1-cos) a a^T.
-  const Eigen::Matrix3d B = 0.5 * (R + R.transpose()) - std::cos(theta) * Eigen::Matrix3d::Identity();
+  // Near pi sin(theta) vanishes: take the axis from the symmetric part, R + R^T = 2 cos I +
+  // 2(1-cos) a a^T.
+  const Eigen::Matrix3d B =
+      0.5 * (R + R.transpose()) - std::cos(theta) * Eigen::Matrix3d::Identity();
   int k = 0;
   B.diagonal().maxCoeff(&k);
   Eigen::Vector3d axis = B.col(k) / std::sqrt(std::max(B(k, k), 1e-300));

@@ -51,8 +51,8 @@ long Trajectory::nearest(double stamp, double max_gap) const {
 std::vector<double> Trajectory::pathLengths() const {
   std::vector<double> lengths(poses_.size(), 0.0);
   for (std::size_t i = 1; i < poses_.size(); ++i) {
-    lengths[i] = lengths[i - 1] +
-                 (poses_[i].pose.translation() - poses_[i - 1].pose.translation()).norm();
+    lengths[i] =
+        lengths[i - 1] + (poses_[i].pose.translation() - poses_[i - 1].pose.translation()).norm();
   }
   return lengths;
 }

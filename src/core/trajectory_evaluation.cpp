@@ -16,7 +16,8 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 double rms(const std::vector<double>& v) {
   if (v.empty()) return 0.0;
   double sum = 0.0;
-  for (double x : v) sum += x * x;
+  for (double x : v)
+    sum += x * x;
   return std::sqrt(sum / static_cast<double>(v.size()));
 }
 
@@ -80,10 +81,12 @@ AteResult computeAte(const AssociatedPoses& poses) {
   }
   if (n >= 3) result.alignment.matrix() = Eigen::umeyama(est, gt, false);
   std::vector<double> errors(n);
-  for (Eigen::Index k = 0; k < n; ++k) errors[k] = (result.alignment * est.col(k) - gt.col(k)).norm();
+  for (Eigen::Index k = 0; k < n; ++k)
+    errors[k] = (result.alignment * est.col(k) - gt.col(k)).norm();
   result.rmse = rms(errors);
   double sum = 0.0;
-  for (double e : errors) sum += e;
+  for (double e : errors)
+    sum += e;
   result.mean = sum / static_cast<double>(n);
   result.max = *std::max_element(errors.begin(), errors.end());
   std::nth_element(errors.begin(), errors.begin() + n / 2, errors.end());
@@ -93,7 +96,8 @@ AteResult computeAte(const AssociatedPoses& poses) {
 
 RpeResult computeRpeFrameToFrame(const AssociatedPoses& poses) {
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t i = 0; i + 1 < poses.size(); ++i) pairs.emplace_back(i, i + 1);
+  for (std::size_t i = 0; i + 1 < poses.size(); ++i)
+    pairs.emplace_back(i, i + 1);
   return rpeOverPairs(poses, pairs);
 }
 
@@ -102,7 +106,8 @@ RpeResult computeRpeFixedDelta(const AssociatedPoses& poses, double delta_s) {
   const std::size_t n = poses.size();
   if (n < 2) return rpeOverPairs(poses, pairs);
   std::vector<double> intervals;
-  for (std::size_t i = 0; i + 1 < n; ++i) intervals.push_back(poses.stamps[i + 1] - poses.stamps[i]);
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    intervals.push_back(poses.stamps[i + 1] - poses.stamps[i]);
   std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
   const double tolerance = std::max(0.5 * intervals[intervals.size() / 2], 1e-3);
   for (std::size_t i = 0; i < n; ++i) {
@@ -123,7 +128,9 @@ RpeResult computeRpeFixedDelta(const AssociatedPoses& poses, double delta_s) {
   return rpeOverPairs(poses, pairs);
 }
 
-std::vector<double> kittiDriftLengths() { return {100, 200, 300, 400, 500, 600, 700, 800}; }
+std::vector<double> kittiDriftLengths() {
+  return {100, 200, 300, 400, 500, 600, 700, 800};
+}
 
 DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<double>& lengths_m,
                               int step) {
@@ -131,8 +138,9 @@ DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<do
   const std::size_t n = poses.size();
   std::vector<double> dist(n, 0.0);
   for (std::size_t i = 1; i < n; ++i) {
-    dist[i] = dist[i - 1] +
-              (poses.ground_truth[i].translation() - poses.ground_truth[i - 1].translation()).norm();
+    dist[i] =
+        dist[i - 1] +
+        (poses.ground_truth[i].translation() - poses.ground_truth[i - 1].translation()).norm();
   }
   double t_sum = 0.0, r_sum = 0.0;
   for (std::size_t first = 0; first < n; first += static_cast<std::size_t>(std::max(step, 1))) {

@@ -56,7 +56,8 @@ Trajectory parseTumTrajectory(std::istream& in, const std::string& source_name) 
     ++line_no;
     if (isBlankOrComment(line)) continue;
     const auto v = parseNumbers(line, source_name, line_no);
-    if (v.size() != 8) throwCount(source_name, line_no, v.size(), "8 (timestamp tx ty tz qx qy qz qw)");
+    if (v.size() != 8)
+      throwCount(source_name, line_no, v.size(), "8 (timestamp tx ty tz qx qy qz qw)");
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     const double norm = q.norm();
     if (std::abs(norm - 1.0) > 1e-2) {
@@ -90,9 +91,9 @@ Trajectory parseKittiTrajectory(std::istream& in, const std::string& source_name
     R << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
     const double ortho_error = (R * R.transpose() - Eigen::Matrix3d::Identity()).norm();
     if (ortho_error > 1e-2 || R.determinant() < 0.0) {
-      throw FormatError(source_name + ":" + std::to_string(line_no) +
-                        ": the 3x3 part is not a rotation (|R R^T - I| = " +
-                        std::to_string(ortho_error) + ")");
+      throw FormatError(
+          source_name + ":" + std::to_string(line_no) +
+          ": the 3x3 part is not a rotation (|R R^T - I| = " + std::to_string(ortho_error) + ")");
     }
     const std::size_t index = trajectory.size();
     if (!stamps.empty() && index >= stamps.size()) {
@@ -157,7 +158,8 @@ void writeKittiTrajectory(std::ostream& out, const Trajectory& trajectory) {
   for (const auto& p : trajectory.poses()) {
     const Eigen::Matrix<double, 3, 4> M = p.pose.matrix().topRows<3>();
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) out << M(r, c) << ((r == 2 && c == 3) ? '\n' : ' ');
+      for (int c = 0; c < 4; ++c)
+        out << M(r, c) << ((r == 2 && c == 3) ? '\n' : ' ');
     }
   }
 }

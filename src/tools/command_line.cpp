@@ -22,7 +22,9 @@ CommandLine::CommandLine(int argc, char** argv, const std::set<std::string>& opt
   }
 }
 
-bool CommandLine::has(const std::string& name) const { return values_.count(name) > 0; }
+bool CommandLine::has(const std::string& name) const {
+  return values_.count(name) > 0;
+}
 
 std::string CommandLine::get(const std::string& name, const std::string& fallback) const {
   auto it = values_.find(name);

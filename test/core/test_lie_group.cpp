@@ -24,15 +24,18 @@ Eigen::Matrix4d matrixExp(const Eigen::Matrix4d& X) {
     term = term * A / k;
     sum += term;
   }
-  for (int k = 0; k < 10; ++k) sum = sum * sum;
+  for (int k = 0; k < 10; ++k)
+    sum = sum * sum;
   return sum;
 }
 
 Vector6d randomTwist(std::mt19937& rng, double rot_scale, double trans_scale) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Vector6d xi;
-  for (int k = 0; k < 3; ++k) xi[k] = rot_scale * u(rng);
-  for (int k = 3; k < 6; ++k) xi[k] = trans_scale * u(rng);
+  for (int k = 0; k < 3; ++k)
+    xi[k] = rot_scale * u(rng);
+  for (int k = 3; k < 6; ++k)
+    xi[k] = trans_scale * u(rng);
   return xi;
 }
 
@@ -124,8 +127,10 @@ TEST(LieGroup, LeftJacobianMatchesNumericalDifferentiation) {
       numeric.col(k) = (plus - minus) / (2.0 * h);
     }
     EXPECT_LT((numeric - lie::leftJacobianSO3(w)).norm(), 1e-8) << "rot " << rot;
-    EXPECT_LT((lie::leftJacobianSO3(w) * lie::leftJacobianInverseSO3(w) -
-               Eigen::Matrix3d::Identity()).norm(), 1e-12);
+    EXPECT_LT(
+        (lie::leftJacobianSO3(w) * lie::leftJacobianInverseSO3(w) - Eigen::Matrix3d::Identity())
+            .norm(),
+        1e-12);
   }
 }
 

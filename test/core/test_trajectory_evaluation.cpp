@@ -31,7 +31,8 @@ TEST(TrajectoryEvaluation, RigidlyMovedEstimateHasZeroAteAndRpe) {
   const Eigen::Isometry3d offset =
       cvo::lie::expSE3((cvo::Vector6d() << 0.3, -0.2, 1.0, 5, -3, 2).finished());
   cvo::Trajectory moved;
-  for (const auto& p : gt.poses()) moved.append(p.stamp, offset * p.pose);
+  for (const auto& p : gt.poses())
+    moved.append(p.stamp, offset * p.pose);
   const auto r = cvo::evaluateTrajectory(gt, moved, {});
   EXPECT_LT(r.ate.rmse, 1e-9);
   EXPECT_LT(r.rpe_frame.translation_rmse, 1e-9);

@@ -20,8 +20,8 @@ std::string errorOf(const std::function<void()>& f) {
 }  // namespace
 
 TEST(TrajectoryIo, ReadsTheTumFixtureGroundTruth) {
-  const auto gt = cvo::readTumTrajectory(std::string(CVO_TEST_DATA_DIR) +
-                                         "/tum_fr1_xyz/groundtruth.txt");
+  const auto gt =
+      cvo::readTumTrajectory(std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz/groundtruth.txt");
   ASSERT_GT(gt.size(), 300u);
   EXPECT_TRUE(gt.isTimeOrdered());
   EXPECT_NEAR(gt[0].stamp, 1305031101.1059, 1e-4);
@@ -41,7 +41,8 @@ TEST(TrajectoryIo, ReadsTheKittiFixtureWithTimes) {
 
 TEST(TrajectoryIo, TumRoundTrip) {
   cvo::Trajectory t;
-  Eigen::Isometry3d pose = cvo::lie::expSE3((cvo::Vector6d() << 0.1, -0.2, 0.3, 1, 2, 3).finished());
+  Eigen::Isometry3d pose =
+      cvo::lie::expSE3((cvo::Vector6d() << 0.1, -0.2, 0.3, 1, 2, 3).finished());
   t.append(1305031102.175304, pose);
   t.append(1305031102.211214, pose * pose);
   std::stringstream ss;
@@ -77,8 +78,9 @@ TEST(TrajectoryIo, MalformedTumLinesNameTheLineAndTheExpectation) {
   EXPECT_NE(errorOf([&] { cvo::parseTumTrajectory(bad_q, "gt.txt"); }).find("gt.txt:1: quaternion"),
             std::string::npos);
   std::stringstream backwards("2.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0 1\n");
-  EXPECT_NE(errorOf([&] { cvo::parseTumTrajectory(backwards, "gt.txt"); })
-                .find("gt.txt:2: timestamps must increase"),
+  EXPECT_NE(errorOf([&] {
+              cvo::parseTumTrajectory(backwards, "gt.txt");
+            }).find("gt.txt:2: timestamps must increase"),
             std::string::npos);
 }
 
@@ -87,12 +89,14 @@ TEST(TrajectoryIo, MalformedKittiLinesNameTheLineAndTheExpectation) {
   EXPECT_EQ(errorOf([&] { cvo::parseKittiTrajectory(few, "poses.txt"); }),
             "poses.txt:2: expected 12 (3x4 pose, row-major), got 11 numbers");
   std::stringstream not_rotation("2 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_NE(errorOf([&] { cvo::parseKittiTrajectory(not_rotation, "poses.txt"); })
-                .find("poses.txt:1: the 3x3 part is not a rotation"),
+  EXPECT_NE(errorOf([&] {
+              cvo::parseKittiTrajectory(not_rotation, "poses.txt");
+            }).find("poses.txt:1: the 3x3 part is not a rotation"),
             std::string::npos);
   std::stringstream two("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_NE(errorOf([&] { cvo::parseKittiTrajectory(two, "poses.txt", {0.0}); })
-                .find("more poses than the 1 timestamps"),
+  EXPECT_NE(errorOf([&] {
+              cvo::parseKittiTrajectory(two, "poses.txt", {0.0});
+            }).find("more poses than the 1 timestamps"),
             std::string::npos);
 }
 

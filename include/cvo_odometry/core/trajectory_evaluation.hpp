@@ -30,7 +30,7 @@ AssociatedPoses associate(const Trajectory& ground_truth, const Trajectory& esti
 
 struct AteResult {
   std::size_t count = 0;
-  double rmse = 0.0, mean = 0.0, median = 0.0, max = 0.0;  // metres
+  double rmse = 0.0, mean = 0.0, median = 0.0, max = 0.0;       // metres
   Eigen::Isometry3d alignment = Eigen::Isometry3d::Identity();  // applied to the estimate
 };
 
@@ -39,10 +39,10 @@ AteResult computeAte(const AssociatedPoses& poses);
 
 struct RpeResult {
   std::size_t count = 0;
-  double translation_rmse = 0.0;      // metres per pair
-  double rotation_rmse_deg = 0.0;     // degrees per pair
-  double translation_rate_rmse = 0.0; // each pair's error over its interval: m/s
-  double rotation_rate_rmse_deg = 0.0;// deg/s
+  double translation_rmse = 0.0;        // metres per pair
+  double rotation_rmse_deg = 0.0;       // degrees per pair
+  double translation_rate_rmse = 0.0;   // each pair's error over its interval: m/s
+  double rotation_rate_rmse_deg = 0.0;  // deg/s
 };
 
 // E = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j) over consecutive pairs (j = i + 1).
@@ -52,9 +52,9 @@ RpeResult computeRpeFrameToFrame(const AssociatedPoses& poses);
 RpeResult computeRpeFixedDelta(const AssociatedPoses& poses, double delta_s);
 
 struct DriftResult {
-  std::size_t count = 0;                 // sub-sequences evaluated
-  double translation_percent = 0.0;      // mean |t_err| / length * 100
-  double rotation_deg_per_m = 0.0;       // mean angle_err / length
+  std::size_t count = 0;             // sub-sequences evaluated
+  double translation_percent = 0.0;  // mean |t_err| / length * 100
+  double rotation_deg_per_m = 0.0;   // mean angle_err / length
 };
 
 // KITTI devkit metric: sub-sequences starting every `step` frames, of path lengths `lengths_m`

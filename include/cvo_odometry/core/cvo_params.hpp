@@ -1,0 +1,64 @@
+// Every parameter of CVO registration, with the TUM RGB-D reference values as defaults.
+// The names follow ../config/*.yaml; see README for what each does.
+#pragma once
+
+#include <string>
+
+namespace cvo {
+
+enum class StepMethod {
+  kReference,  // the paper: normalised gradient, 4th-order Taylor line search, indicator annealing
+  kProcrustes  // default: closed-form weighted Procrustes (MM) step, coarse-to-fine lengthscales
+};
+
+enum class BackendChoice { kAuto, kCpu, kCuda };
+
+struct CvoParams {
+  // Geometric kernel k(x, z) = sigma^2 exp(-|x - z|^2 / (2 ell^2)).
+  double ell_init = 0.15;         // lengthscale at the start of a registration (m)
+  double ell_min = 0.05;          // smallest lengthscale of the annealing (m)
+  double ell_first_frame = 0.15;  // ell_init for the first pair of a sequence (identity guess)
+  double sigma = 0.1;             // amplitude s
+  double sp_thres = 0.003;        // a pair counts only if its kernel product exceeds this
+
+  // Appearance kernels s_V^2 exp(-|u - v|^2 / (2 ell_V^2)), multiplied into the pair weight.
+  bool use_color = true;
+  double color_ell = 0.15;
+  double color_sigma = 0.6;
+  bool use_semantics = false;
+  double semantic_ell = 0.1;
+  double semantic_sigma = 0.8;
+
+  // Reference annealing: when the retained-pair ratio of the last `indicator_window` iterations is
+  // within 1 +- indicator_tolerance of the window before, ell <- max(ell * decay_rate, ell_min).
+  double decay_rate = 0.9;
+  int decay_start = 10;
+  double first_frame_decay_rate = 0.9;
+  int first_frame_decay_start = 10;
+  int indicator_window = 5;
+  double indicator_tolerance = 0.02;
+
+  // Step and convergence.
+  StepMethod step_method = StepMethod::kProcrustes;
+  double min_step = 1e-5;  // Taylor step clamp (reference method)
+  double max_step = 0.8;
+  double eps_2 = 1.2e-5;  // stop when |log(increment)| < eps_2 (at ell_min for Procrustes)
+  int max_iterations = 2000;
+  // Procrustes schedule: converge loosely at each lengthscale (|step| < level_tolerance * ell),
+  // then ell <- max(ell * schedule_decay, ell_min); stop on eps_2 only at ell_min.
+  double schedule_decay = 0.7;
+  double level_tolerance = 0.01;
+
+  BackendChoice backend = BackendChoice::kAuto;
+  int num_threads = 0;  // 0: all cores
+
+  // Throws std::invalid_argument naming the first parameter that makes no sense.
+  void validate() const;
+};
+
+std::string toString(StepMethod method);
+std::string toString(BackendChoice backend);
+StepMethod parseStepMethod(const std::string& name);
+BackendChoice parseBackendChoice(const std::string& name);
+
+}  // namespace cvo

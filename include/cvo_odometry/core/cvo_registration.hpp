@@ -1,0 +1,60 @@
+// CVO registration of a source cloud to a target cloud: finds T (target <- source) maximising
+// F(T) = sum_ij a(x_i, T z_j), with the step method and lengthscale schedule of CvoParams.
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/cvo_params.hpp"
+#include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/core/registration_backend.hpp"
+#include "cvo_odometry/core/registration_report.hpp"
+
+namespace cvo {
+
+struct RegistrationResult {
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // target <- source
+  RegistrationReport report;
+};
+
+class CvoRegistration {
+ public:
+  // Throws std::invalid_argument if `params` make no sense. Without a backend, one is chosen
+  // from params.backend (see makeBackend).
+  explicit CvoRegistration(const CvoParams& params,
+                           std::unique_ptr<RegistrationBackend> backend = nullptr);
+  ~CvoRegistration();
+
+  // Throws std::invalid_argument for empty clouds, non-finite points or features the enabled
+  // kernels need but the clouds lack. A registration that finds no pairs within the kernels'
+  // reach returns converged = false with the guess and says so in the message.
+  RegistrationResult align(const LabeledCloud& target, const LabeledCloud& source,
+                           const Eigen::Isometry3d& initial_guess, bool first_frame = false);
+
+  // F(T) at lengthscale `ell` (sparse sum over retained pairs).
+  double innerProduct(const LabeledCloud& target, const LabeledCloud& source,
+                      const Eigen::Isometry3d& T, double ell);
+  // The paper's alignment indicator F / sqrt(|X||Z|).
+  double indicator(const LabeledCloud& target, const LabeledCloud& source,
+                   const Eigen::Isometry3d& T, double ell);
+  // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1].
+  double cosine(const LabeledCloud& target, const LabeledCloud& source, const Eigen::Isometry3d& T,
+                double ell);
+
+  const CvoParams& params() const { return params_; }
+  void setParams(const CvoParams& params);
+  RegistrationBackend& backend() { return *backend_; }
+
+ private:
+  void checkInputs(const LabeledCloud& target, const LabeledCloud& source) const;
+  void runProcrustes(const Eigen::Isometry3d& guess, double ell, Eigen::Isometry3d& T,
+                     RegistrationReport& report);
+  void runReference(const Eigen::Isometry3d& guess, double ell, bool first_frame,
+                    Eigen::Isometry3d& T, RegistrationReport& report);
+
+  CvoParams params_;
+  std::unique_ptr<RegistrationBackend> backend_;
+};
+
+}  // namespace cvo

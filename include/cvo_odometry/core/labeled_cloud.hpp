@@ -1,0 +1,60 @@
+// A point cloud with appearance features: positions, an optional colour feature per point
+// (5-D: B, G, R in [0,1] and the two image gradients, see cvo-method notes) and an optional
+// semantic class-probability vector (number of classes chosen at run time).
+// Memory: one contiguous float array per attribute, point-major, so a kernel reads one point's
+// position or feature vector with a single strided load on the CPU and the GPU alike.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace cvo {
+
+class LabeledCloud {
+ public:
+  static constexpr int kColorDim = 5;
+
+  LabeledCloud() = default;
+  // `semantic_classes` = 0 for a cloud without semantics.
+  explicit LabeledCloud(bool has_color, int semantic_classes = 0);
+
+  void reserve(std::size_t n);
+  // `color` must point to kColorDim floats when the cloud has colour, `semantics` to
+  // semanticClasses() floats when it has semantics; either may be null otherwise.
+  void add(const Eigen::Vector3f& position, const float* color = nullptr,
+           const float* semantics = nullptr);
+
+  std::size_t size() const { return positions_.size() / 3; }
+  bool empty() const { return positions_.empty(); }
+  bool hasColor() const { return has_color_; }
+  int semanticClasses() const { return semantic_classes_; }
+
+  Eigen::Map<const Eigen::Vector3f> position(std::size_t i) const {
+    return Eigen::Map<const Eigen::Vector3f>(&positions_[3 * i]);
+  }
+  const float* color(std::size_t i) const { return &colors_[kColorDim * i]; }
+  const float* semantics(std::size_t i) const {
+    return &semantics_[static_cast<std::size_t>(semantic_classes_) * i];
+  }
+
+  const std::vector<float>& positionData() const { return positions_; }
+  const std::vector<float>& colorData() const { return colors_; }
+  const std::vector<float>& semanticData() const { return semantics_; }
+
+  // A copy with every position moved by `T` (features unchanged).
+  LabeledCloud transformed(const Eigen::Isometry3f& T) const;
+  // Index of the first point with a non-finite position or feature, or -1.
+  long firstNonFinite() const;
+
+ private:
+  bool has_color_ = false;
+  int semantic_classes_ = 0;
+  std::vector<float> positions_;
+  std::vector<float> colors_;
+  std::vector<float> semantics_;
+};
+
+}  // namespace cvo

@@ -1,0 +1,193 @@
+// The per-pair arithmetic of CVO, written once for the CPU backend and the CUDA kernels
+// (compiled as __host__ __device__ by nvcc). No Eigen or STL here: plain floats and doubles.
+//
+// Pair weight of target point x_i and moved source point z_j:
+//   a_ij = s^2 exp(-|x_i - z_j|^2 / (2 ell^2)) * prod_V s_V^2 exp(-|u_i - v_j|^2 / (2 ell_V^2))
+// and the pair counts (is "retained") only when a_ij > sp_thres.
+#pragma once
+
+#include <math.h>
+
+#if defined(__CUDACC__)
+#define CVO_HOST_DEVICE __host__ __device__
+#else
+#define CVO_HOST_DEVICE
+#endif
+
+namespace cvo {
+namespace kernels {
+
+constexpr int kColorDim = 5;
+
+// Kernel settings for one registration, copied by value to the device.
+struct KernelConstants {
+  float sigma2;  // s^2
+  float sp_thres;
+  int use_color;             // 0 or 1
+  float color_inv_two_ell2;  // 1 / (2 ell_c^2)
+  float color_sigma2;
+  int semantic_classes;  // 0: semantics off
+  float semantic_inv_two_ell2;
+  float semantic_sigma2;
+};
+
+// Sums over retained pairs with the source moved by the current estimate: enough for F, its
+// se(3) gradient and the weighted Procrustes step.
+struct MomentSums {
+  double weight;     // F = sum a
+  double target[3];  // sum a x
+  double source[3];  // sum a z
+  double cross[9];   // sum a x z^T, row-major
+  unsigned long long pairs;
+};
+
+// Coefficients of F(exp(t xi) T) ~ F0 + B t + C t^2 + D t^3 + E t^4 (reference step).
+struct TaylorSums {
+  double b, c, d, e;
+};
+
+// Per-source-point partial sums over its neighbours: sum a and sum a x.
+struct PointSums {
+  double weight;
+  double target[3];
+};
+
+CVO_HOST_DEVICE inline void clear(MomentSums& m) {
+  m.weight = 0.0;
+  for (int k = 0; k < 3; ++k)
+    m.target[k] = m.source[k] = 0.0;
+  for (int k = 0; k < 9; ++k)
+    m.cross[k] = 0.0;
+  m.pairs = 0;
+}
+
+CVO_HOST_DEVICE inline void add(MomentSums& m, const MomentSums& o) {
+  m.weight += o.weight;
+  for (int k = 0; k < 3; ++k) {
+    m.target[k] += o.target[k];
+    m.source[k] += o.source[k];
+  }
+  for (int k = 0; k < 9; ++k)
+    m.cross[k] += o.cross[k];
+  m.pairs += o.pairs;
+}
+
+CVO_HOST_DEVICE inline void clear(PointSums& p) {
+  p.weight = 0.0;
+  p.target[0] = p.target[1] = p.target[2] = 0.0;
+}
+
+CVO_HOST_DEVICE inline float squaredDistance(const float* a, const float* b, int dim) {
+  float sum = 0.0f;
+  for (int k = 0; k < dim; ++k) {
+    const float d = a[k] - b[k];
+    sum += d * d;
+  }
+  return sum;
+}
+
+// s^2 times the appearance factors: the part of a_ij that does not move with the pose.
+// Colour and semantic pointers may be null when that kernel is off.
+CVO_HOST_DEVICE inline float appearanceWeight(const KernelConstants& k, const float* color_x,
+                                              const float* color_z, const float* semantic_x,
+                                              const float* semantic_z) {
+  float w = k.sigma2;
+  if (k.use_color) {
+    w *=
+        k.color_sigma2 * expf(-squaredDistance(color_x, color_z, kColorDim) * k.color_inv_two_ell2);
+  }
+  if (k.semantic_classes > 0) {
+    w *= k.semantic_sigma2 * expf(-squaredDistance(semantic_x, semantic_z, k.semantic_classes) *
+                                  k.semantic_inv_two_ell2);
+  }
+  return w;
+}
+
+// a_ij from the pose-independent part and the squared distance of the moved points.
+CVO_HOST_DEVICE inline float pairWeight(float appearance, float distance2, float inv_two_ell2) {
+  return appearance * expf(-distance2 * inv_two_ell2);
+}
+
+CVO_HOST_DEVICE inline bool isRetained(float weight, float sp_thres) {
+  return weight > sp_thres;
+}
+
+CVO_HOST_DEVICE inline void accumulatePair(PointSums& p, float weight, const float* x) {
+  p.weight += weight;
+  for (int k = 0; k < 3; ++k)
+    p.target[k] += static_cast<double>(weight) * x[k];
+}
+
+// Folds one source point's neighbour sums into the moments: sum a z = A z, sum a x z^T = X z^T.
+CVO_HOST_DEVICE inline void accumulatePoint(MomentSums& m, const PointSums& p, const float* z,
+                                            unsigned long long pairs) {
+  m.weight += p.weight;
+  for (int r = 0; r < 3; ++r) {
+    m.target[r] += p.target[r];
+    m.source[r] += p.weight * z[r];
+    for (int c = 0; c < 3; ++c)
+      m.cross[3 * r + c] += p.target[r] * z[c];
+  }
+  m.pairs += pairs;
+}
+
+// Moves a point by a row-major 3x4 float transform.
+CVO_HOST_DEVICE inline void transformPoint(const float* T, const float* p, float* out) {
+  for (int r = 0; r < 3; ++r) {
+    out[r] = T[4 * r] * p[0] + T[4 * r + 1] * p[1] + T[4 * r + 2] * p[2] + T[4 * r + 3];
+  }
+}
+
+// Derivatives of exp(t xi) z at t = 0: u_k = W^(k-1) (W z + v), W = [omega]x.
+struct TaylorFrame {
+  double u[4][3];
+  double u1u1, u1u2, u2u2, u1u3;
+};
+
+CVO_HOST_DEVICE inline void cross3(const double* a, const double* b, double* out) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+CVO_HOST_DEVICE inline double dot3(const double* a, const double* b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+CVO_HOST_DEVICE inline void makeTaylorFrame(const float* z, const double* xi, TaylorFrame& f) {
+  const double zd[3] = {z[0], z[1], z[2]};
+  cross3(xi, zd, f.u[0]);
+  for (int k = 0; k < 3; ++k)
+    f.u[0][k] += xi[3 + k];
+  for (int n = 1; n < 4; ++n)
+    cross3(xi, f.u[n - 1], f.u[n]);
+  f.u1u1 = dot3(f.u[0], f.u[0]);
+  f.u1u2 = dot3(f.u[0], f.u[1]);
+  f.u2u2 = dot3(f.u[1], f.u[1]);
+  f.u1u3 = dot3(f.u[0], f.u[2]);
+}
+
+// Adds a * (coefficients of exp(g(t)) - 1) for one pair, where g(t) is the change of the
+// exponent -|x - exp(t xi) z|^2 / (2 ell^2), expanded to 4th order with d = x - z:
+//   g = beta t + gamma t^2 + delta t^3 + eps t^4.
+CVO_HOST_DEVICE inline void accumulateTaylorPair(TaylorSums& s, const TaylorFrame& f,
+                                                 const float* x, const float* z, double weight,
+                                                 double inv_ell2) {
+  const double d[3] = {static_cast<double>(x[0]) - z[0], static_cast<double>(x[1]) - z[1],
+                       static_cast<double>(x[2]) - z[2]};
+  const double du1 = dot3(d, f.u[0]), du2 = dot3(d, f.u[1]);
+  const double du3 = dot3(d, f.u[2]), du4 = dot3(d, f.u[3]);
+  const double half = 0.5 * inv_ell2;
+  const double beta = du1 * inv_ell2;
+  const double gamma = -(f.u1u1 - du2) * half;
+  const double delta = -(f.u1u2 - du3 / 3.0) * half;
+  const double eps = -(0.25 * f.u2u2 + f.u1u3 / 3.0 - du4 / 12.0) * half;
+  s.b += weight * beta;
+  s.c += weight * (gamma + 0.5 * beta * beta);
+  s.d += weight * (delta + beta * gamma + beta * beta * beta / 6.0);
+  s.e += weight * (eps + beta * delta + 0.5 * beta * beta * gamma + 0.5 * gamma * gamma +
+                   beta * beta * beta * beta / 24.0);
+}
+
+}  // namespace kernels
+}  // namespace cvo

@@ -1,0 +1,41 @@
+// Where the double sums of CVO are computed. The registration algorithm (steps, schedule,
+// convergence) is shared; a backend only evaluates sums over retained pairs, the same sums on
+// every backend (up to floating-point rounding).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/cvo_params.hpp"
+#include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/pair_kernels.hpp"
+
+namespace cvo {
+
+class RegistrationBackend {
+ public:
+  virtual ~RegistrationBackend() = default;
+  virtual std::string name() const = 0;
+
+  // The clouds and kernel settings for the following calls. The clouds must stay alive and
+  // unchanged until the next setProblem.
+  virtual void setProblem(const LabeledCloud& target, const LabeledCloud& source,
+                          const CvoParams& params) = 0;
+  // Sums over the retained pairs (x_i, T z_j) at lengthscale `ell`.
+  virtual kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) = 0;
+  // Taylor coefficients of F(exp(t xi) T) in t, over the pairs retained at T.
+  virtual kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi,
+                                     double ell) = 0;
+};
+
+// Squared cut-off of the scaled joint distance D^2 = |x - z|^2 / ell^2 + sum_V |u - v|^2 / ell_V^2:
+// a pair can be retained only if D^2 < this (its kernel product is then above sp_thres).
+double retainedScaledDistance2(const CvoParams& params);
+kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semantic_classes);
+// Row-major 3x4 float copy of T for the kernels.
+void toRowMajor3x4(const Eigen::Isometry3d& T, float* out);
+
+}  // namespace cvo

@@ -1,0 +1,37 @@
+#include "cvo_odometry/core/backend_factory.hpp"
+
+#include <stdexcept>
+
+#include "cvo_odometry/core/cpu_backend.hpp"
+#ifdef CVO_HAVE_CUDA
+#include "cvo_odometry/core/cuda_backend.hpp"
+#endif
+
+namespace cvo {
+
+bool cudaBackendAvailable(std::string* why_not) {
+#ifdef CVO_HAVE_CUDA
+  return cudaDeviceUsable(why_not);
+#else
+  if (why_not)
+    *why_not = "this build has no CUDA backend (built without nvcc or CVO_WITH_CUDA=OFF)";
+  return false;
+#endif
+}
+
+std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads) {
+  if (choice != BackendChoice::kCpu) {
+    std::string why_not;
+    if (cudaBackendAvailable(&why_not)) {
+#ifdef CVO_HAVE_CUDA
+      return std::make_unique<CudaBackend>(num_threads);
+#endif
+    }
+    if (choice == BackendChoice::kCuda) {
+      throw std::runtime_error("CUDA backend requested but unavailable: " + why_not);
+    }
+  }
+  return std::make_unique<CpuBackend>(num_threads);
+}
+
+}  // namespace cvo

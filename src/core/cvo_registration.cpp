@@ -1,0 +1,197 @@
+#include "cvo_odometry/core/cvo_registration.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <stdexcept>
+
+#include "cvo_odometry/core/backend_factory.hpp"
+#include "cvo_odometry/core/cvo_steps.hpp"
+
+namespace cvo {
+
+namespace {
+
+double stepNorm(const Eigen::Isometry3d& increment) {
+  return lie::logSE3(increment).norm();
+}
+
+}  // namespace
+
+CvoRegistration::CvoRegistration(const CvoParams& params,
+                                 std::unique_ptr<RegistrationBackend> backend)
+    : params_(params), backend_(std::move(backend)) {
+  params_.validate();
+  if (!backend_) backend_ = makeBackend(params_.backend, params_.num_threads);
+}
+
+CvoRegistration::~CvoRegistration() = default;
+
+void CvoRegistration::setParams(const CvoParams& params) {
+  params.validate();
+  params_ = params;
+}
+
+void CvoRegistration::checkInputs(const LabeledCloud& target, const LabeledCloud& source) const {
+  for (const auto* cloud : {&target, &source}) {
+    const char* which = cloud == &target ? "target" : "source";
+    if (cloud->size() < 3) {
+      throw std::invalid_argument(std::string(which) + " cloud has " +
+                                  std::to_string(cloud->size()) + " points; at least 3 needed");
+    }
+    const long bad = cloud->firstNonFinite();
+    if (bad >= 0) {
+      throw std::invalid_argument(std::string(which) + " cloud point " + std::to_string(bad) +
+                                  " has a non-finite position or feature");
+    }
+    if (params_.use_color && !cloud->hasColor()) {
+      throw std::invalid_argument(std::string("use_color is on but the ") + which +
+                                  " cloud has no colour");
+    }
+    if (params_.use_semantics && cloud->semanticClasses() == 0) {
+      throw std::invalid_argument(std::string("use_semantics is on but the ") + which +
+                                  " cloud has no semantics");
+    }
+  }
+  if (params_.use_semantics && target.semanticClasses() != source.semanticClasses()) {
+    throw std::invalid_argument("target has " + std::to_string(target.semanticClasses()) +
+                                " semantic classes, source " +
+                                std::to_string(source.semanticClasses()));
+  }
+}
+
+RegistrationResult CvoRegistration::align(const LabeledCloud& target, const LabeledCloud& source,
+                                          const Eigen::Isometry3d& initial_guess,
+                                          bool first_frame) {
+  const auto start = std::chrono::steady_clock::now();
+  checkInputs(target, source);
+  if (!initial_guess.matrix().allFinite()) {
+    throw std::invalid_argument("initial guess is not finite");
+  }
+  backend_->setProblem(target, source, params_);
+  RegistrationResult result;
+  RegistrationReport& report = result.report;
+  report.backend = backend_->name();
+  const double ell = first_frame ? params_.ell_first_frame : params_.ell_init;
+  report.initial_lengthscale = ell;
+  const Eigen::Isometry3d guess = lie::orthonormalized(initial_guess);
+  if (params_.step_method == StepMethod::kProcrustes) {
+    runProcrustes(guess, ell, result.transform, report);
+  } else {
+    runReference(guess, ell, first_frame, result.transform, report);
+  }
+  const double norm = std::sqrt(static_cast<double>(target.size()) * source.size());
+  report.indicator_after =
+      backend_->moments(result.transform, report.final_lengthscale).weight / norm;
+  report.indicator_before = backend_->moments(guess, report.final_lengthscale).weight / norm;
+  report.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
+                                    Eigen::Isometry3d& T, RegistrationReport& report) {
+  T = guess;
+  double pair_total = 0.0;
+  report.message = "iteration limit reached";
+  for (int it = 0; it < params_.max_iterations; ++it) {
+    const kernels::MomentSums m = backend_->moments(T, ell);
+    report.iterations = it + 1;
+    pair_total += static_cast<double>(m.pairs);
+    if (m.pairs < 3) {
+      report.message =
+          "fewer than 3 pairs within the kernels' reach at lengthscale " + std::to_string(ell);
+      break;
+    }
+    const Eigen::Isometry3d increment = weightedProcrustes(m);
+    T = lie::orthonormalized(increment * T);
+    report.last_step = stepNorm(increment);
+    if (ell > params_.ell_min) {
+      if (report.last_step < params_.level_tolerance * ell) {
+        ell = std::max(ell * params_.schedule_decay, params_.ell_min);
+        ++report.lengthscale_decays;
+      }
+    } else if (report.last_step < params_.eps_2) {
+      report.converged = true;
+      report.message = "converged";
+      break;
+    }
+  }
+  report.final_lengthscale = ell;
+  report.mean_pairs = report.iterations ? pair_total / report.iterations : 0.0;
+}
+
+void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, bool first_frame,
+                                   Eigen::Isometry3d& T, RegistrationReport& report) {
+  T = guess;
+  const double decay = first_frame ? params_.first_frame_decay_rate : params_.decay_rate;
+  const int decay_start = first_frame ? params_.first_frame_decay_start : params_.decay_start;
+  const auto window = static_cast<std::size_t>(params_.indicator_window);
+  std::deque<double> ratios;
+  double pair_total = 0.0;
+  report.message = "iteration limit reached";
+  for (int it = 0; it < params_.max_iterations; ++it) {
+    const kernels::MomentSums m = backend_->moments(T, ell);
+    report.iterations = it + 1;
+    pair_total += static_cast<double>(m.pairs);
+    if (m.pairs == 0) {
+      report.message = "no pairs within the kernels' reach at lengthscale " + std::to_string(ell);
+      break;
+    }
+    const Vector6d gradient = objectiveGradient(m, ell);
+    if (!(gradient.norm() > 0.0)) {
+      report.converged = true;
+      report.message = "zero gradient";
+      break;
+    }
+    const Vector6d direction = gradient.normalized();
+    const double step =
+        taylorStepLength(backend_->taylor(T, direction, ell), params_.min_step, params_.max_step);
+    T = lie::orthonormalized(lie::expSE3(step * direction) * T);
+    report.last_step = step;
+    if (step < params_.eps_2) {
+      report.converged = true;
+      report.message = "converged";
+      break;
+    }
+    // Annealing on the retained-pair count (the reference's indicator; its 1/sqrt(NM) cancels in
+    // the ratio of two adjacent windows).
+    ratios.push_back(static_cast<double>(m.pairs));
+    if (ratios.size() > 2 * window) ratios.pop_front();
+    if (it >= decay_start && ratios.size() == 2 * window && ell > params_.ell_min) {
+      const double previous = std::accumulate(ratios.begin(), ratios.begin() + window, 0.0);
+      const double recent = std::accumulate(ratios.begin() + window, ratios.end(), 0.0);
+      if (previous > 0.0 && std::abs(recent / previous - 1.0) <= params_.indicator_tolerance) {
+        ell = std::max(ell * decay, params_.ell_min);
+        ++report.lengthscale_decays;
+        ratios.clear();
+      }
+    }
+  }
+  report.final_lengthscale = ell;
+  report.mean_pairs = report.iterations ? pair_total / report.iterations : 0.0;
+}
+
+double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCloud& source,
+                                     const Eigen::Isometry3d& T, double ell) {
+  checkInputs(target, source);
+  backend_->setProblem(target, source, params_);
+  return backend_->moments(T, ell).weight;
+}
+
+double CvoRegistration::indicator(const LabeledCloud& target, const LabeledCloud& source,
+                                  const Eigen::Isometry3d& T, double ell) {
+  return innerProduct(target, source, T, ell) /
+         std::sqrt(static_cast<double>(target.size()) * source.size());
+}
+
+double CvoRegistration::cosine(const LabeledCloud& target, const LabeledCloud& source,
+                               const Eigen::Isometry3d& T, double ell) {
+  const double cross = innerProduct(target, source, T, ell);
+  const double self_target = innerProduct(target, target, Eigen::Isometry3d::Identity(), ell);
+  const double self_source = innerProduct(source, source, Eigen::Isometry3d::Identity(), ell);
+  return cross / std::sqrt(self_target * self_source);
+}
+
+}  // namespace cvo

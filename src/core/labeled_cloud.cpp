@@ -1,0 +1,57 @@
+#include "cvo_odometry/core/labeled_cloud.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace cvo {
+
+LabeledCloud::LabeledCloud(bool has_color, int semantic_classes)
+    : has_color_(has_color), semantic_classes_(semantic_classes) {
+  if (semantic_classes < 0) throw std::invalid_argument("semantic class count must be >= 0");
+}
+
+void LabeledCloud::reserve(std::size_t n) {
+  positions_.reserve(3 * n);
+  if (has_color_) colors_.reserve(kColorDim * n);
+  semantics_.reserve(static_cast<std::size_t>(semantic_classes_) * n);
+}
+
+void LabeledCloud::add(const Eigen::Vector3f& position, const float* color,
+                       const float* semantics) {
+  if (has_color_ && color == nullptr)
+    throw std::invalid_argument("cloud has colour: colour needed");
+  if (semantic_classes_ > 0 && semantics == nullptr) {
+    throw std::invalid_argument("cloud has semantics: class probabilities needed");
+  }
+  positions_.insert(positions_.end(), position.data(), position.data() + 3);
+  if (has_color_) colors_.insert(colors_.end(), color, color + kColorDim);
+  if (semantic_classes_ > 0)
+    semantics_.insert(semantics_.end(), semantics, semantics + semantic_classes_);
+}
+
+LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
+  LabeledCloud out = *this;
+  for (std::size_t i = 0; i < size(); ++i) {
+    Eigen::Map<Eigen::Vector3f>(&out.positions_[3 * i]) = T * position(i);
+  }
+  return out;
+}
+
+long LabeledCloud::firstNonFinite() const {
+  const std::size_t sem = static_cast<std::size_t>(semantic_classes_);
+  for (std::size_t i = 0; i < size(); ++i) {
+    bool finite = std::isfinite(positions_[3 * i]) && std::isfinite(positions_[3 * i + 1]) &&
+                  std::isfinite(positions_[3 * i + 2]);
+    for (int k = 0; finite && has_color_ && k < kColorDim; ++k) {
+      finite = std::isfinite(colors_[kColorDim * i + k]);
+    }
+    for (std::size_t k = 0; finite && k < sem; ++k)
+      finite = std::isfinite(semantics_[sem * i + k]);
+    if (!finite) return static_cast<long>(i);
+  }
+  return -1;
+}
+
+}  // namespace cvo

@@ -1,0 +1,34 @@
+#include "cvo_odometry/core/registration_backend.hpp"
+
+#include <cmath>
+
+namespace cvo {
+
+double retainedScaledDistance2(const CvoParams& params) {
+  double max_weight = params.sigma * params.sigma;
+  if (params.use_color) max_weight *= params.color_sigma * params.color_sigma;
+  if (params.use_semantics) max_weight *= params.semantic_sigma * params.semantic_sigma;
+  return 2.0 * std::log(max_weight / params.sp_thres);
+}
+
+kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semantic_classes) {
+  kernels::KernelConstants k{};
+  k.sigma2 = static_cast<float>(params.sigma * params.sigma);
+  k.sp_thres = static_cast<float>(params.sp_thres);
+  k.use_color = params.use_color ? 1 : 0;
+  k.color_inv_two_ell2 = static_cast<float>(0.5 / (params.color_ell * params.color_ell));
+  k.color_sigma2 = static_cast<float>(params.color_sigma * params.color_sigma);
+  k.semantic_classes = params.use_semantics ? semantic_classes : 0;
+  k.semantic_inv_two_ell2 = static_cast<float>(0.5 / (params.semantic_ell * params.semantic_ell));
+  k.semantic_sigma2 = static_cast<float>(params.semantic_sigma * params.semantic_sigma);
+  return k;
+}
+
+void toRowMajor3x4(const Eigen::Isometry3d& T, float* out) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c)
+      out[4 * r + c] = static_cast<float>(T.matrix()(r, c));
+  }
+}
+
+}  // namespace cvo

@@ -1,0 +1,290 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cvo_odometry/core/cpu_backend.hpp"
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/cvo_steps.hpp"
+#include "synthetic_scene.hpp"
+
+using cvo::CvoParams;
+using cvo::CvoRegistration;
+using cvo::LabeledCloud;
+using cvo::Vector6d;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+CvoParams syntheticParams(bool color) {
+  CvoParams p;
+  p.backend = cvo::BackendChoice::kCpu;
+  p.use_color = color;
+  p.ell_first_frame = 0.5;  // identity guess, up to 15 deg / 0.3 m away
+  return p;
+}
+
+Eigen::Isometry3d pose(double rx, double ry, double rz, double tx, double ty, double tz) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() << tx, ty, tz;
+  return T;
+}
+
+double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return (a.inverse() * b).translation().norm();
+}
+double rotationErrorDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return cvo::lie::rotationAngle((a.inverse() * b).linear()) / kDeg;
+}
+
+// F(T) through the CPU backend.
+double objective(cvo::CpuBackend& backend, const Eigen::Isometry3d& T, double ell) {
+  return backend.moments(T, ell).weight;
+}
+
+}  // namespace
+
+TEST(CvoObjective, GradientMatchesFiniteDifferences) {
+  CvoParams params = syntheticParams(true);
+  params.sp_thres = 1e-9;  // no pair crosses the threshold within the differencing step
+  const LabeledCloud target = cvo_test::roomScene(600, 1);
+  const LabeledCloud source = cvo_test::roomScene(600, 2);
+  cvo::CpuBackend backend(1);
+  backend.setProblem(target, source, params);
+  const Eigen::Isometry3d T = pose(0.03, -0.02, 0.05, 0.04, -0.03, 0.02);
+  const double ell = 0.1;
+  const Vector6d analytic = cvo::objectiveGradient(backend.moments(T, ell), ell);
+  const double h = 1e-4;
+  for (int k = 0; k < 6; ++k) {
+    Vector6d dxi = Vector6d::Zero();
+    dxi[k] = h;
+    const double numeric = (objective(backend, cvo::lie::expSE3(dxi) * T, ell) -
+                            objective(backend, cvo::lie::expSE3(-dxi) * T, ell)) /
+                           (2.0 * h);
+    EXPECT_NEAR(analytic[k], numeric, 2e-3 * analytic.norm()) << "component " << k;
+  }
+}
+
+TEST(CvoObjective, TaylorModelMatchesTheObjectiveAlongTheStep) {
+  CvoParams params = syntheticParams(false);
+  params.sp_thres = 1e-9;
+  const LabeledCloud target = cvo_test::roomScene(600, 3, false);
+  const LabeledCloud source = cvo_test::roomScene(600, 4, false);
+  cvo::CpuBackend backend(1);
+  backend.setProblem(target, source, params);
+  const Eigen::Isometry3d T = pose(0.02, 0.01, -0.03, 0.03, 0.02, -0.01);
+  const double ell = 0.1;
+  const Vector6d xi = cvo::objectiveGradient(backend.moments(T, ell), ell).normalized();
+  const cvo::kernels::TaylorSums s = backend.taylor(T, xi, ell);
+  const double f0 = objective(backend, T, ell);
+  double previous_error = 0.0;
+  for (double t : {0.02, 0.01}) {
+    const double actual = objective(backend, cvo::lie::expSE3(t * xi) * T, ell) - f0;
+    const double model = s.b * t + s.c * t * t + s.d * t * t * t + s.e * t * t * t * t;
+    const double error = std::abs(actual - model);
+    EXPECT_LT(error, 2e-3 * std::abs(actual)) << "t = " << t;
+    // A 4th-order model errs by O(t^5): halving t shrinks the error about 32 times (F is summed
+    // from float pair weights, so smaller steps drown in rounding).
+    if (previous_error > 0.0) {
+      EXPECT_LT(error, previous_error / 10.0) << "t = " << t;
+    }
+    previous_error = error;
+  }
+}
+
+struct KnownTransformCase {
+  const char* name;
+  bool color;
+  cvo::StepMethod method;
+  Eigen::Isometry3d truth;
+};
+
+void PrintTo(const KnownTransformCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class CvoKnownTransform : public ::testing::TestWithParam<KnownTransformCase> {};
+
+TEST_P(CvoKnownTransform, IsRecoveredToAMillimetreAndFiveHundredthsOfADegree) {
+  const auto& c = GetParam();
+  CvoParams params = syntheticParams(c.color);
+  params.step_method = c.method;
+  if (c.method == cvo::StepMethod::kReference) {
+    params.ell_first_frame = params.ell_init;  // its case is small; the reference is slow
+  }
+  const LabeledCloud target = cvo_test::roomScene(3000, 10, c.color);
+  // The source sees the same room from a pose moved by truth: z = truth^-1 x. With colour it is
+  // an independent sampling of the room; geometry alone on independent samplings of these flat
+  // faces has its maximum of F ~0.2 deg off the truth (sampling noise, measured), so the
+  // geometric cases move the target's own samples.
+  const unsigned source_seed = c.color ? 11 : 10;
+  const LabeledCloud source =
+      cvo_test::roomScene(3000, source_seed, c.color).transformed(c.truth.inverse().cast<float>());
+  CvoRegistration registration(params);
+  const auto result = registration.align(target, source, Eigen::Isometry3d::Identity(), true);
+  EXPECT_TRUE(result.report.converged) << result.report.message;
+  EXPECT_LT(translationError(result.transform, c.truth), 1e-3);
+  EXPECT_LT(rotationErrorDeg(result.transform, c.truth), 0.05);
+  EXPECT_GT(result.report.indicator_after, result.report.indicator_before);
+  if (c.method == cvo::StepMethod::kProcrustes) {
+    // The reference stop rule may end before the last decay; the default schedule may not.
+    EXPECT_NEAR(result.report.final_lengthscale, params.ell_min, 1e-12);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Synthetic, CvoKnownTransform,
+    ::testing::Values(KnownTransformCase{"geometric_small", false, cvo::StepMethod::kProcrustes,
+                                         pose(2 * kDeg, -1 * kDeg, 3 * kDeg, 0.05, -0.02, 0.03)},
+                      KnownTransformCase{"geometric_15deg_yaw", false, cvo::StepMethod::kProcrustes,
+                                         pose(0, 0, 15 * kDeg, 0.1, 0.1, 0.0)},
+                      KnownTransformCase{"geometric_30cm", false, cvo::StepMethod::kProcrustes,
+                                         pose(5 * kDeg, 4 * kDeg, -6 * kDeg, 0.3, -0.1, 0.05)},
+                      KnownTransformCase{"color_15deg_mixed", true, cvo::StepMethod::kProcrustes,
+                                         pose(8 * kDeg, -10 * kDeg, 6 * kDeg, -0.1, 0.2, 0.1)},
+                      KnownTransformCase{"color_30cm", true, cvo::StepMethod::kProcrustes,
+                                         pose(-3 * kDeg, 2 * kDeg, 10 * kDeg, 0.25, 0.15, -0.05)},
+                      KnownTransformCase{"reference_geometric", false, cvo::StepMethod::kReference,
+                                         pose(3 * kDeg, -2 * kDeg, 4 * kDeg, 0.06, 0.04, -0.03)}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(CvoAmbiguity, ColourFixesASlideAlongAPlaneThatGeometryCannot) {
+  const Eigen::Isometry3d truth = pose(0, 0, 0, 0.06, -0.04, 0.0);
+  for (bool color : {false, true}) {
+    CvoParams params = syntheticParams(color);
+    params.ell_init = 0.1;
+    // The source patch lies inside the target plane: no edge for geometry to use.
+    const LabeledCloud target = cvo_test::texturedPlane(6000, 20, 0.0f, 1.6f, color);
+    const LabeledCloud source = cvo_test::texturedPlane(2500, 21, 0.4f, 1.2f, color)
+                                    .transformed(truth.inverse().cast<float>());
+    CvoRegistration registration(params);
+    const auto result = registration.align(target, source, Eigen::Isometry3d::Identity());
+    const double error = translationError(result.transform, truth);
+    if (color) {
+      EXPECT_LT(error, 1e-3) << "colour should pin the in-plane position";
+    } else {
+      // A flat plane looks the same slid in itself: geometry alone stays near the guess.
+      EXPECT_GT(error, 0.05);
+    }
+  }
+}
+
+TEST(CvoAmbiguity, SemanticsFixASlideAlongAPlaneThatGeometryCannot) {
+  const Eigen::Isometry3d truth = pose(0, 0, 0, 0.06, 0.0, 0.0);
+  CvoParams params = syntheticParams(false);
+  params.ell_init = 0.1;
+  params.use_semantics = true;
+  params.semantic_ell = 0.3;
+  params.semantic_sigma = 1.0;
+  const LabeledCloud target = cvo_test::texturedPlane(6000, 30, 0.0f, 1.6f, false, 3);
+  const LabeledCloud source = cvo_test::texturedPlane(2500, 31, 0.4f, 1.2f, false, 3)
+                                  .transformed(truth.inverse().cast<float>());
+  CvoRegistration with_labels(params);
+  const auto labelled = with_labels.align(target, source, Eigen::Isometry3d::Identity());
+  // Stripes across x pin x, to within the sampling of the stripe edges; geometry alone cannot.
+  EXPECT_LT(std::abs((labelled.transform.translation() - truth.translation()).x()), 1e-2);
+  params.use_semantics = false;
+  CvoRegistration geometry_only(params);
+  const auto plain = geometry_only.align(target, source, Eigen::Isometry3d::Identity());
+  EXPECT_GT(std::abs((plain.transform.translation() - truth.translation()).x()), 0.04);
+}
+
+TEST(CvoRegistration, ResultsAreIdenticalRunToRunAndAcrossThreadCounts) {
+  CvoParams params = syntheticParams(true);
+  const LabeledCloud target = cvo_test::roomScene(2000, 40);
+  const LabeledCloud source = cvo_test::roomScene(2000, 41).transformed(
+      pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
+  CvoRegistration one(params, std::make_unique<cvo::CpuBackend>(1));
+  CvoRegistration two(params, std::make_unique<cvo::CpuBackend>(2));
+  const auto a = one.align(target, source, Eigen::Isometry3d::Identity(), true);
+  const auto b = one.align(target, source, Eigen::Isometry3d::Identity(), true);
+  const auto c = two.align(target, source, Eigen::Isometry3d::Identity(), true);
+  EXPECT_EQ(a.transform.matrix(), b.transform.matrix());
+  EXPECT_EQ(a.transform.matrix(), c.transform.matrix());
+  EXPECT_EQ(a.report.iterations, c.report.iterations);
+  EXPECT_EQ(a.report.indicator_after, c.report.indicator_after);
+}
+
+TEST(CvoIndicator, IsLargestAtAlignmentAndCosineIsOneForIdenticalClouds) {
+  CvoParams params = syntheticParams(true);
+  const LabeledCloud cloud = cvo_test::roomScene(1500, 50);
+  CvoRegistration registration(params);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  EXPECT_NEAR(registration.cosine(cloud, cloud, I, 0.05), 1.0, 1e-9);
+  const double at_truth = registration.indicator(cloud, cloud, I, 0.05);
+  double previous = at_truth;
+  for (double shift : {0.01, 0.02, 0.04, 0.08}) {
+    const double moved = registration.indicator(cloud, cloud, pose(0, 0, 0, shift, 0, 0), 0.05);
+    EXPECT_LT(moved, previous) << "shift " << shift;
+    previous = moved;
+  }
+  const double cos_moved = registration.cosine(cloud, cloud, pose(0, 0, 0.1, 0, 0, 0), 0.05);
+  EXPECT_GT(cos_moved, 0.0);
+  EXPECT_LT(cos_moved, 0.9);
+}
+
+TEST(CvoRegistration, NoOverlapIsReportedNotHidden) {
+  CvoParams params = syntheticParams(false);
+  const LabeledCloud target = cvo_test::roomScene(500, 60, false);
+  const LabeledCloud source =
+      cvo_test::roomScene(500, 61, false).transformed(pose(0, 0, 0, 50.0, 0, 0).cast<float>());
+  CvoRegistration registration(params);
+  const auto result = registration.align(target, source, Eigen::Isometry3d::Identity());
+  EXPECT_FALSE(result.report.converged);
+  EXPECT_NE(result.report.message.find("pairs within the kernels' reach"), std::string::npos);
+  EXPECT_EQ(result.report.indicator_after, 0.0);
+}
+
+TEST(CvoRegistration, BadInputGivesClearErrors) {
+  CvoParams params = syntheticParams(true);
+  CvoRegistration registration(params);
+  const LabeledCloud good = cvo_test::roomScene(100, 70);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  auto message = [&](const LabeledCloud& t, const LabeledCloud& s) -> std::string {
+    try {
+      registration.align(t, s, I);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(message(LabeledCloud(true), good), "target cloud has 0 points; at least 3 needed");
+  LabeledCloud with_nan = good;
+  const float color[5] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+  with_nan.add(Eigen::Vector3f(NAN, 0.0f, 1.0f), color);
+  EXPECT_EQ(message(good, with_nan), "source cloud point 100 has a non-finite position or feature");
+  EXPECT_EQ(message(good, cvo_test::roomScene(100, 71, false)),
+            "use_color is on but the source cloud has no colour");
+  Eigen::Isometry3d bad_guess = I;
+  bad_guess.translation().x() = NAN;
+  EXPECT_THROW(registration.align(good, good, bad_guess), std::invalid_argument);
+}
+
+TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
+  auto message = [](const CvoParams& p) -> std::string {
+    try {
+      p.validate();
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CvoParams p;
+  EXPECT_EQ(message(p), "");
+  p.ell_init = -0.1;
+  EXPECT_NE(message(p).find("ell_init must be a positive"), std::string::npos);
+  p = CvoParams();
+  p.ell_min = 0.5;
+  EXPECT_NE(message(p).find("ell_min (0.500000) > ell_init (0.150000)"), std::string::npos);
+  p = CvoParams();
+  p.sp_thres = 0.01;  // s^2 s_c^2 = 0.0036
+  EXPECT_NE(message(p).find("no pair could count"), std::string::npos);
+  p = CvoParams();
+  p.min_step = 1.0;
+  EXPECT_NE(message(p).find("min_step > max_step"), std::string::npos);
+  EXPECT_THROW(CvoRegistration{p}, std::invalid_argument);
+}
