@@ -13,21 +13,95 @@ namespace {
 
 // Block size of the deterministic reduction.
 constexpr std::size_t kBlockSize = 128;
-// Extra scaled distance kept in the candidate lists: the source may move skin * ell before the
-// lists must be rebuilt.
-constexpr double kSkin = 0.5;
+// Extra scaled distance kept in freshly built candidate lists: the source may move margin * ell
+// before the lists must be rebuilt.
+constexpr double kSkin = 0.35;
+// Below this margin a lengthscale decrease rebuilds from the grid instead of refiltering.
+constexpr double kMinMargin = 0.2;
+
+// Sums over the `count` candidates of one source point z. `appearance` null: every pair's
+// appearance factor is `constant` (geometry only). Plain float reductions so that the compiler
+// vectorises the loop; compiled for AVX-512, AVX2 and baseline x86-64, picked at load time.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CVO_CPU_DISPATCH __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define CVO_CPU_DISPATCH
+#endif
+CVO_CPU_DISPATCH kernels::PointSums sumCandidates(const float* xs, const float* ys, const float* zs,
+                                                  const float* appearance, float constant,
+                                                  int count, const float* z, float inv_two_ell2,
+                                                  float sp_thres) {
+  const float zx = z[0], zy = z[1], zz = z[2];
+  float weight = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f, pairs = 0.0f;
+  if (appearance == nullptr) {
+#pragma omp simd reduction(+ : weight, ox, oy, oz, pairs)
+    for (int c = 0; c < count; ++c) {
+      const float dx = xs[c] - zx, dy = ys[c] - zy, dz = zs[c] - zz;
+      const float a = kernels::retainedPairWeight(constant, dx, dy, dz, inv_two_ell2, sp_thres);
+      weight += a;
+      ox += a * dx;
+      oy += a * dy;
+      oz += a * dz;
+      pairs += a > 0.0f ? 1.0f : 0.0f;
+    }
+  } else {
+#pragma omp simd reduction(+ : weight, ox, oy, oz, pairs)
+    for (int c = 0; c < count; ++c) {
+      const float dx = xs[c] - zx, dy = ys[c] - zy, dz = zs[c] - zz;
+      const float a =
+          kernels::retainedPairWeight(appearance[c], dx, dy, dz, inv_two_ell2, sp_thres);
+      weight += a;
+      ox += a * dx;
+      oy += a * dy;
+      oz += a * dz;
+      pairs += a > 0.0f ? 1.0f : 0.0f;
+    }
+  }
+  return kernels::PointSums{weight, {ox, oy, oz}, static_cast<unsigned int>(pairs)};
+}
 
 }  // namespace
+
+void CpuBackend::Block::clear() {
+  resize(0);
+}
+
+void CpuBackend::Block::resize(std::size_t n) {
+  for (auto* v : {&x, &y, &z, &appearance, &appearance_d2})
+    v->resize(n);
+  target.resize(n);
+}
+
+void CpuBackend::Block::push(std::uint32_t index, const float* position, float weight,
+                             float distance2) {
+  target.push_back(index);
+  x.push_back(position[0]);
+  y.push_back(position[1]);
+  z.push_back(position[2]);
+  appearance.push_back(weight);
+  appearance_d2.push_back(distance2);
+}
+
+void CpuBackend::Block::move(std::size_t from, std::size_t to) {
+  target[to] = target[from];
+  x[to] = x[from];
+  y[to] = y[from];
+  z[to] = z[from];
+  appearance[to] = appearance[from];
+  appearance_d2[to] = appearance_d2[from];
+}
 
 void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& source,
                             const CvoParams& params) {
   target_ = &target;
   source_ = &source;
   constants_ = makeKernelConstants(params, source.semanticClasses());
+  constant_appearance_ = !constants_.use_color && constants_.semantic_classes == 0;
   cutoff2_ = retainedScaledDistance2(params);
   candidates_valid_ = false;
   rebuilds_ = 0;
-  blocks_.assign((source.size() + kBlockSize - 1) / kBlockSize, Block());
+  // Blocks keep their storage across problems: no reallocation (and page faults) per level.
+  blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
 }
 
 int CpuBackend::threadCount() const {
@@ -45,12 +119,22 @@ std::size_t CpuBackend::candidatePairs() const {
   return n;
 }
 
+double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
+  const Eigen::Isometry3d relative = T * built_pose_.inverse();
+  return lie::rotationAngle(relative.linear()) * built_radius_ + relative.translation().norm();
+}
+
 void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
-  if (candidates_valid_ && ell == built_ell_) {
-    const Eigen::Isometry3d relative = T * built_pose_.inverse();
-    const double moved =
-        lie::rotationAngle(relative.linear()) * built_radius_ + relative.translation().norm();
-    if (moved < kSkin * ell) return;
+  if (candidates_valid_) {
+    const double moved = movedSinceBuild(T);
+    if (ell == built_ell_ && moved < margin_ * ell) return;
+    if (ell < built_ell_) {
+      const double margin = margin_ - moved / built_ell_;
+      if (margin >= kMinMargin) {
+        refilterCandidates(T, ell, margin);
+        return;
+      }
+    }
   }
   buildCandidates(T, ell);
 }
@@ -59,17 +143,11 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   ++rebuilds_;
   const double reach = std::sqrt(cutoff2_) + kSkin;  // scaled joint distance kept
   const float radius = static_cast<float>(reach * ell);
-  if (grid_.cellSize() != radius || !candidates_valid_ || ell != built_ell_) {
-    grid_.build(target_->positionData().data(), target_->size(), radius);
-  }
+  grid_.build(target_->positionData().data(), target_->size(), radius);
   float pose[12];
   toRowMajor3x4(T, pose);
-  const double max_weight_log =
-      std::log(static_cast<double>(constants_.sigma2)) +
-      (constants_.use_color ? std::log(constants_.color_sigma2) : 0.0) +
-      (constants_.semantic_classes ? std::log(constants_.semantic_sigma2) : 0.0);
-  const double inv_ell2 = 1.0 / (ell * ell);
-  const double reach2 = reach * reach;
+  const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
+  const float reach2 = static_cast<float>(reach * reach);
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
   const bool color = constants_.use_color;
@@ -80,8 +158,7 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   for (long b = 0; b < block_count; ++b) {
     Block& block = blocks_[b];
     block.offsets.assign(1, 0);
-    block.target.clear();
-    block.appearance.clear();
+    block.clear();
     const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
     for (std::size_t j = begin; j < end; ++j) {
@@ -90,24 +167,58 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
       radius_max = std::max(
           radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
       grid_.forEachWithin(z, radius, [&](std::uint32_t i) {
-        const float appearance = kernels::appearanceWeight(
+        const float geometric = kernels::squaredDistance(tgt + 3 * i, z, 3) * inv_ell2;
+        const float appearance_d2 = kernels::appearanceDistance2(
             constants_, color ? target_->color(i) : nullptr, color ? source_->color(j) : nullptr,
             semantic ? target_->semantics(i) : nullptr, semantic ? source_->semantics(j) : nullptr);
-        if (!(appearance > 0.0f)) return;
-        // Scaled joint distance^2: geometric part plus the appearance part recovered from the
-        // weight.
-        const double geometric = kernels::squaredDistance(tgt + 3 * i, z, 3) * inv_ell2;
-        const double joint = geometric - 2.0 * (std::log(double(appearance)) - max_weight_log);
-        if (joint < reach2) {
-          block.target.push_back(i);
-          block.appearance.push_back(appearance);
-        }
+        if (geometric + appearance_d2 >= reach2) return;
+        block.push(i, tgt + 3 * i, kernels::appearanceWeight(constants_, appearance_d2),
+                   appearance_d2);
       });
       block.offsets.push_back(static_cast<std::uint32_t>(block.target.size()));
     }
   }
   candidates_valid_ = true;
   built_ell_ = ell;
+  margin_ = kSkin;
+  built_pose_ = T;
+  built_radius_ = radius_max;
+}
+
+void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin) {
+  const double reach = std::sqrt(cutoff2_) + margin;
+  float pose[12];
+  toRowMajor3x4(T, pose);
+  const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
+  const float reach2 = static_cast<float>(reach * reach);
+  const float* src = source_->positionData().data();
+  const long block_count = static_cast<long>(blocks_.size());
+  double radius_max = 0.0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount()) reduction(max : radius_max)
+  for (long b = 0; b < block_count; ++b) {
+    Block& block = blocks_[b];
+    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    const std::size_t points = block.offsets.size() - 1;
+    std::uint32_t kept = 0, first = 0;
+    for (std::size_t k = 0; k < points; ++k) {
+      float z[3];
+      kernels::transformPoint(pose, src + 3 * (begin + k), z);
+      radius_max = std::max(
+          radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
+      const std::uint32_t last = block.offsets[k + 1];
+      for (std::uint32_t c = first; c < last; ++c) {
+        const float x[3] = {block.x[c], block.y[c], block.z[c]};
+        const float d2 = kernels::squaredDistance(x, z, 3) * inv_ell2;
+        if (d2 + block.appearance_d2[c] >= reach2) continue;
+        block.move(c, kept++);
+      }
+      first = last;
+      block.offsets[k + 1] = kept;
+    }
+    block.resize(kept);
+  }
+  built_ell_ = ell;
+  margin_ = margin;
   built_pose_ = T;
   built_radius_ = radius_max;
 }
@@ -117,7 +228,9 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
-  const float* tgt = target_->positionData().data();
+  const float sp_thres = constants_.sp_thres;
+  const float constant_appearance = constants_.max_weight;
+  const bool constant = constant_appearance_;
   const float* src = source_->positionData().data();
   const long block_count = static_cast<long>(blocks_.size());
   std::vector<kernels::MomentSums> partial(blocks_.size());
@@ -131,18 +244,16 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
     for (std::size_t k = 0; k < points; ++k) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * (begin + k), z);
-      kernels::PointSums sums;
-      kernels::clear(sums);
-      unsigned long long pairs = 0;
-      for (std::uint32_t c = block.offsets[k]; c < block.offsets[k + 1]; ++c) {
-        const float* x = tgt + 3 * block.target[c];
-        const float a = kernels::pairWeight(block.appearance[c], kernels::squaredDistance(x, z, 3),
-                                            inv_two_ell2);
-        if (!kernels::isRetained(a, constants_.sp_thres)) continue;
-        kernels::accumulatePair(sums, a, x);
-        ++pairs;
-      }
-      if (pairs > 0) kernels::accumulatePoint(m, sums, z, pairs);
+      const std::uint32_t first = block.offsets[k];
+      const int count = static_cast<int>(block.offsets[k + 1] - first);
+      const float* xs = block.x.data() + first;
+      const float* ys = block.y.data() + first;
+      const float* zs = block.z.data() + first;
+      const float* appearance = block.appearance.data() + first;
+      const kernels::PointSums sums =
+          sumCandidates(xs, ys, zs, constant ? nullptr : appearance, constant_appearance, count, z,
+                        inv_two_ell2, sp_thres);
+      if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
   }
   kernels::MomentSums total;
@@ -158,7 +269,6 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const double inv_ell2 = 1.0 / (ell * ell);
-  const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
   const long block_count = static_cast<long>(blocks_.size());
   std::vector<kernels::TaylorSums> partial(blocks_.size());
@@ -174,11 +284,10 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
       kernels::TaylorFrame frame;
       kernels::makeTaylorFrame(z, xi.data(), frame);
       for (std::uint32_t c = block.offsets[k]; c < block.offsets[k + 1]; ++c) {
-        const float* x = tgt + 3 * block.target[c];
-        const float a = kernels::pairWeight(block.appearance[c], kernels::squaredDistance(x, z, 3),
-                                            inv_two_ell2);
-        if (!kernels::isRetained(a, constants_.sp_thres)) continue;
-        kernels::accumulateTaylorPair(s, frame, x, z, a, inv_ell2);
+        const float x[3] = {block.x[c], block.y[c], block.z[c]};
+        const float a = kernels::retainedPairWeight(block.appearance[c], x[0] - z[0], x[1] - z[1],
+                                                    x[2] - z[2], inv_two_ell2, constants_.sp_thres);
+        if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, inv_ell2);
       }
     }
     partial[b] = s;

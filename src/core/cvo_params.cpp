@@ -57,7 +57,10 @@ void CvoParams::validate() const {
   require(min_step <= max_step, "min_step > max_step");
   requirePositive(eps_2, "eps_2");
   requirePositive(level_tolerance, "level_tolerance");
+  require(max_overrelaxation >= 1.0 && max_overrelaxation <= 3.0,
+          "max_overrelaxation must be in [1, 3]");
   require(max_iterations >= 1, "max_iterations must be >= 1");
+  require(max_level_iterations >= 1, "max_level_iterations must be >= 1");
   require(num_threads >= 0, "num_threads must be >= 0");
 }
 

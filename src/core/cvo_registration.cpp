@@ -1,5 +1,6 @@
 #include "cvo_odometry/core/cvo_registration.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -10,14 +11,6 @@
 #include "cvo_odometry/core/cvo_steps.hpp"
 
 namespace cvo {
-
-namespace {
-
-double stepNorm(const Eigen::Isometry3d& increment) {
-  return lie::logSE3(increment).norm();
-}
-
-}  // namespace
 
 CvoRegistration::CvoRegistration(const CvoParams& params,
                                  std::unique_ptr<RegistrationBackend> backend)
@@ -69,7 +62,9 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   if (!initial_guess.matrix().allFinite()) {
     throw std::invalid_argument("initial guess is not finite");
   }
-  backend_->setProblem(target, source, params_);
+  target_ = &target;
+  source_ = &source;
+  stride_ = 0;
   RegistrationResult result;
   RegistrationReport& report = result.report;
   report.backend = backend_->name();
@@ -81,6 +76,7 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   } else {
     runReference(guess, ell, first_frame, result.transform, report);
   }
+  useFullClouds();  // the indicators are over every point
   const double norm = std::sqrt(static_cast<double>(target.size()) * source.size());
   report.indicator_after =
       backend_->moments(result.transform, report.final_lengthscale).weight / norm;
@@ -94,8 +90,14 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
                                     Eigen::Isometry3d& T, RegistrationReport& report) {
   T = guess;
   double pair_total = 0.0;
+  // Adaptive over-relaxation: the MM step is conservative, so while F keeps rising the step is
+  // stretched (up to max_overrelaxation); a fall resets it. Restarted at every level.
+  double omega = 1.0;
+  double previous_weight = -1.0;
+  int level_iterations = 0;
   report.message = "iteration limit reached";
   for (int it = 0; it < params_.max_iterations; ++it) {
+    useCloudsForLengthscale(ell);
     const kernels::MomentSums m = backend_->moments(T, ell);
     report.iterations = it + 1;
     pair_total += static_cast<double>(m.pairs);
@@ -104,13 +106,30 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
           "fewer than 3 pairs within the kernels' reach at lengthscale " + std::to_string(ell);
       break;
     }
-    const Eigen::Isometry3d increment = weightedProcrustes(m);
-    T = lie::orthonormalized(increment * T);
-    report.last_step = stepNorm(increment);
+    // The MM fixed point is a stationary point of the continuous sum_ij (a_ij - sp_thres)_+
+    // (the retained-pair sum F jumps as pairs cross the threshold): steer by that.
+    const double smooth_weight = m.weight - params_.sp_thres * static_cast<double>(m.pairs);
+    if (previous_weight >= 0.0) {
+      omega = smooth_weight >= previous_weight ? std::min(omega * 1.5, params_.max_overrelaxation)
+                                               : 1.0;
+    }
+    previous_weight = smooth_weight;
+    const Vector6d step = lie::logSE3(weightedProcrustes(m));
+    T = lie::orthonormalized(lie::expSE3(omega * step) * T);
+    report.last_step = step.norm();  // the plain MM step decides convergence
+    ++level_iterations;
     if (ell > params_.ell_min) {
-      if (report.last_step < params_.level_tolerance * ell) {
-        ell = std::max(ell * params_.schedule_decay, params_.ell_min);
+      // A coarse level ends when its steps are small, or after max_level_iterations (the
+      // thresholded sum can make the step hop between nearby states there).
+      if (report.last_step < params_.level_tolerance * ell ||
+          level_iterations >= params_.max_level_iterations) {
+        level_iterations = 0;
+        ell *= params_.schedule_decay;
+        // A level just above ell_min costs a full level and gains nothing: go to ell_min.
+        if (ell < params_.ell_min * 1.15) ell = params_.ell_min;
         ++report.lengthscale_decays;
+        omega = 1.0;
+        previous_weight = -1.0;
       }
     } else if (report.last_step < params_.eps_2) {
       report.converged = true;
@@ -131,6 +150,7 @@ void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, b
   std::deque<double> ratios;
   double pair_total = 0.0;
   report.message = "iteration limit reached";
+  useFullClouds();  // the reference sums over every point
   for (int it = 0; it < params_.max_iterations; ++it) {
     const kernels::MomentSums m = backend_->moments(T, ell);
     report.iterations = it + 1;
@@ -171,6 +191,30 @@ void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, b
   }
   report.final_lengthscale = ell;
   report.mean_pairs = report.iterations ? pair_total / report.iterations : 0.0;
+}
+
+int CvoRegistration::useCloudsForLengthscale(double ell) {
+  int stride = 1;
+  if (params_.subsample_coarse_levels && ell > params_.ell_min) {
+    // Never below ~500 points a cloud: sparser clouds give too few (colour) pairs to steer by.
+    const std::size_t smaller = std::min(target_->size(), source_->size());
+    const int most = std::max(1, static_cast<int>(smaller / 500));
+    stride = std::clamp(static_cast<int>(std::lround(ell / params_.ell_min)), 1, most);
+  }
+  if (stride != stride_) {
+    stride_ = stride;
+    if (stride > 1) {
+      strided_target_ = target_->strided(static_cast<std::size_t>(stride));
+      strided_source_ = source_->strided(static_cast<std::size_t>(stride));
+    }
+    backend_->setProblem(stride > 1 ? strided_target_ : *target_,
+                         stride > 1 ? strided_source_ : *source_, params_);
+  }
+  return stride;
+}
+
+void CvoRegistration::useFullClouds() {
+  useCloudsForLengthscale(params_.ell_min);
 }
 
 double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCloud& source,

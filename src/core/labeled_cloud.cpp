@@ -1,5 +1,6 @@
 #include "cvo_odometry/core/labeled_cloud.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -35,6 +36,16 @@ LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
   LabeledCloud out = *this;
   for (std::size_t i = 0; i < size(); ++i) {
     Eigen::Map<Eigen::Vector3f>(&out.positions_[3 * i]) = T * position(i);
+  }
+  return out;
+}
+
+LabeledCloud LabeledCloud::strided(std::size_t stride) const {
+  LabeledCloud out(has_color_, semantic_classes_);
+  out.reserve(size() / std::max<std::size_t>(stride, 1) + 1);
+  for (std::size_t i = 0; i < size(); i += std::max<std::size_t>(stride, 1)) {
+    out.add(position(i), has_color_ ? color(i) : nullptr,
+            semantic_classes_ ? semantics(i) : nullptr);
   }
   return out;
 }

@@ -40,6 +40,9 @@ void visitScalars(Params& p, Visitor&& f) {
   f("max_iterations", p.max_iterations);
   f("schedule_decay", p.schedule_decay);
   f("level_tolerance", p.level_tolerance);
+  f("subsample_coarse_levels", p.subsample_coarse_levels);
+  f("max_overrelaxation", p.max_overrelaxation);
+  f("max_level_iterations", p.max_level_iterations);
   f("num_threads", p.num_threads);
 }
 

@@ -13,14 +13,15 @@ double retainedScaledDistance2(const CvoParams& params) {
 
 kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semantic_classes) {
   kernels::KernelConstants k{};
-  k.sigma2 = static_cast<float>(params.sigma * params.sigma);
+  double max_weight = params.sigma * params.sigma;
+  if (params.use_color) max_weight *= params.color_sigma * params.color_sigma;
+  if (params.use_semantics) max_weight *= params.semantic_sigma * params.semantic_sigma;
+  k.max_weight = static_cast<float>(max_weight);
   k.sp_thres = static_cast<float>(params.sp_thres);
   k.use_color = params.use_color ? 1 : 0;
-  k.color_inv_two_ell2 = static_cast<float>(0.5 / (params.color_ell * params.color_ell));
-  k.color_sigma2 = static_cast<float>(params.color_sigma * params.color_sigma);
+  k.color_inv_ell2 = static_cast<float>(1.0 / (params.color_ell * params.color_ell));
   k.semantic_classes = params.use_semantics ? semantic_classes : 0;
-  k.semantic_inv_two_ell2 = static_cast<float>(0.5 / (params.semantic_ell * params.semantic_ell));
-  k.semantic_sigma2 = static_cast<float>(params.semantic_sigma * params.semantic_sigma);
+  k.semantic_inv_ell2 = static_cast<float>(1.0 / (params.semantic_ell * params.semantic_ell));
   return k;
 }
 

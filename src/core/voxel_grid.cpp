@@ -6,8 +6,13 @@
 
 namespace cvo {
 
-int VoxelGrid::cellCoord(float v) const {
-  return static_cast<int>(std::floor(v / cell_size_));
+namespace {
+// Dense grids up to this many cells (16 MB of offsets); beyond, the hash map.
+constexpr double kMaxDenseCells = 4.0e6;
+}  // namespace
+
+int VoxelGrid::cellCoord(float v, int axis) const {
+  return static_cast<int>(std::floor((v - origin_[axis]) / cell_size_));
 }
 
 std::uint64_t VoxelGrid::key(int x, int y, int z) {
@@ -20,26 +25,64 @@ std::uint64_t VoxelGrid::key(int x, int y, int z) {
 }
 
 void VoxelGrid::build(const float* positions, std::size_t count, float cell_size) {
-  positions_ = positions;
   cell_size_ = cell_size;
-  std::vector<std::uint64_t> keys(count);
+  float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = count ? positions[a] : 0.0f;
+    hi[a] = lo[a];
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], positions[3 * i + a]);
+      hi[a] = std::max(hi[a], positions[3 * i + a]);
+    }
+  }
+  double cells = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    origin_[a] = lo[a];
+    dims_[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size)) + 1;
+    cells *= dims_[a];
+  }
+  dense_ = cells <= kMaxDenseCells;
+
+  std::vector<std::uint64_t> cell_of(count);
   for (std::size_t i = 0; i < count; ++i) {
     const float* p = positions + 3 * i;
-    keys[i] = key(cellCoord(p[0]), cellCoord(p[1]), cellCoord(p[2]));
+    const int x = cellCoord(p[0], 0), y = cellCoord(p[1], 1), z = cellCoord(p[2], 2);
+    cell_of[i] =
+        dense_ ? (static_cast<std::uint64_t>(x) * dims_[1] + y) * dims_[2] + z : key(x, y, z);
   }
   order_.resize(count);
   std::iota(order_.begin(), order_.end(), 0u);
-  std::stable_sort(order_.begin(), order_.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
-  cells_.clear();
-  cells_.reserve(count);
-  for (std::uint32_t k = 0; k < count;) {
-    std::uint32_t end = k + 1;
-    while (end < count && keys[order_[end]] == keys[order_[k]])
-      ++end;
-    cells_.emplace(keys[order_[k]], std::make_pair(k, end));
-    k = end;
+  if (dense_) {
+    // Counting sort: stable, so the order within a cell is the input order.
+    start_.assign(static_cast<std::size_t>(cells) + 1, 0u);
+    for (std::size_t i = 0; i < count; ++i)
+      ++start_[cell_of[i] + 1];
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < count; ++i)
+      order_[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    cells_.clear();
+  } else {
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return cell_of[a] < cell_of[b]; });
+    cells_.clear();
+    cells_.reserve(count);
+    for (std::uint32_t k = 0; k < count;) {
+      std::uint32_t end = k + 1;
+      while (end < count && cell_of[order_[end]] == cell_of[order_[k]])
+        ++end;
+      cells_.emplace(cell_of[order_[k]], std::make_pair(k, end));
+      k = end;
+    }
+    start_.clear();
   }
+  sorted_storage_.resize(3 * count);
+  for (std::size_t k = 0; k < count; ++k) {
+    std::copy(positions + 3 * order_[k], positions + 3 * order_[k] + 3, &sorted_storage_[3 * k]);
+  }
+  sorted_ = sorted_storage_.data();
 }
 
 }  // namespace cvo

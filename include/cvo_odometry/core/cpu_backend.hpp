@@ -32,22 +32,37 @@ class CpuBackend : public RegistrationBackend {
   struct Block {
     std::vector<std::uint32_t> offsets;  // size = points in block + 1
     std::vector<std::uint32_t> target;
-    std::vector<float> appearance;  // s^2 times the appearance factors of the pair
+    std::vector<float> x, y, z;        // the target point, copied: unit-stride loads vectorise
+    std::vector<float> appearance;     // s^2 times the appearance factors of the pair
+    std::vector<float> appearance_d2;  // scaled appearance distance (pose independent)
+
+    void clear();
+    void push(std::uint32_t index, const float* position, float weight, float distance2);
+    // Keeps candidate `from` at slot `to` (to <= from).
+    void move(std::size_t from, std::size_t to);
+    void resize(std::size_t n);
   };
 
   void ensureCandidates(const Eigen::Isometry3d& T, double ell);
+  // Candidates from the grid, kept when the scaled joint distance < sqrt(cutoff) + margin.
   void buildCandidates(const Eigen::Isometry3d& T, double ell);
+  // After a lengthscale decrease: the joint distance only grows as ell shrinks, so the new list
+  // is a filter of the old one, with the old margin less what the source moved since.
+  void refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin);
+  double movedSinceBuild(const Eigen::Isometry3d& T) const;
   int threadCount() const;
 
   int num_threads_;
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   kernels::KernelConstants constants_{};
-  double cutoff2_ = 0.0;  // retained iff scaled joint distance^2 below this
+  bool constant_appearance_ = true;  // geometry only: every pair's appearance is s^2
+  double cutoff2_ = 0.0;             // retained iff scaled joint distance^2 below this
   VoxelGrid grid_;
   std::vector<Block> blocks_;
   bool candidates_valid_ = false;
   double built_ell_ = 0.0;
+  double margin_ = 0.0;  // lists hold every pair within sqrt(cutoff) + margin
   Eigen::Isometry3d built_pose_ = Eigen::Isometry3d::Identity();
   double built_radius_ = 0.0;  // largest |T_built z|: bounds how far a rotation moves a point
   int rebuilds_ = 0;

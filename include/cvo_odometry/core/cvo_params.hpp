@@ -48,6 +48,13 @@ struct CvoParams {
   // then ell <- max(ell * schedule_decay, ell_min); stop on eps_2 only at ell_min.
   double schedule_decay = 0.7;
   double level_tolerance = 0.01;
+  // At lengthscales above ell_min use every k-th point of each cloud, k ~ ell / ell_min, so that
+  // pairs per iteration stay near the finest level's; the finest level uses every point.
+  bool subsample_coarse_levels = true;
+  // Largest stretch of the Procrustes step while F keeps rising (1: plain MM steps).
+  double max_overrelaxation = 2.0;
+  // Iterations after which a coarse level ends even if its steps are not yet small.
+  int max_level_iterations = 30;
 
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;  // 0: all cores

@@ -53,8 +53,19 @@ class CvoRegistration {
   void runReference(const Eigen::Isometry3d& guess, double ell, bool first_frame,
                     Eigen::Isometry3d& T, RegistrationReport& report);
 
+  // Sets the backend's problem for lengthscale `ell`: the full clouds at ell_min; above it, when
+  // subsampling is on, every k-th point of each, k ~ ell / ell_min, so that pairs per
+  // iteration stay near the finest level's. Returns k.
+  int useCloudsForLengthscale(double ell);
+  void useFullClouds();
+
   CvoParams params_;
   std::unique_ptr<RegistrationBackend> backend_;
+  const LabeledCloud* target_ = nullptr;
+  const LabeledCloud* source_ = nullptr;
+  LabeledCloud strided_target_;
+  LabeledCloud strided_source_;
+  int stride_ = 0;
 };
 
 }  // namespace cvo

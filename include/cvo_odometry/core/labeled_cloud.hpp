@@ -46,6 +46,8 @@ class LabeledCloud {
 
   // A copy with every position moved by `T` (features unchanged).
   LabeledCloud transformed(const Eigen::Isometry3f& T) const;
+  // Every `stride`-th point, starting with the first.
+  LabeledCloud strided(std::size_t stride) const;
   // Index of the first point with a non-finite position or feature, or -1.
   long firstNonFinite() const;
 

@@ -21,14 +21,12 @@ constexpr int kColorDim = 5;
 
 // Kernel settings for one registration, copied by value to the device.
 struct KernelConstants {
-  float sigma2;  // s^2
+  float max_weight;  // s^2 * s_c^2 * s_s^2 over the kernels in use
   float sp_thres;
-  int use_color;             // 0 or 1
-  float color_inv_two_ell2;  // 1 / (2 ell_c^2)
-  float color_sigma2;
-  int semantic_classes;  // 0: semantics off
-  float semantic_inv_two_ell2;
-  float semantic_sigma2;
+  int use_color;            // 0 or 1
+  float color_inv_ell2;     // 1 / ell_c^2
+  int semantic_classes;     // 0: semantics off
+  float semantic_inv_ell2;  // 1 / ell_s^2
 };
 
 // Sums over retained pairs with the source moved by the current estimate: enough for F, its
@@ -46,10 +44,12 @@ struct TaylorSums {
   double b, c, d, e;
 };
 
-// Per-source-point partial sums over its neighbours: sum a and sum a x.
+// Per-source-point partial sums over its neighbours, in float (a few hundred terms at most):
+// sum a and sum a (x - z), the offsets being small keeps the float sums accurate.
 struct PointSums {
-  double weight;
-  double target[3];
+  float weight;
+  float offset[3];
+  unsigned int pairs;
 };
 
 CVO_HOST_DEVICE inline void clear(MomentSums& m) {
@@ -73,8 +73,35 @@ CVO_HOST_DEVICE inline void add(MomentSums& m, const MomentSums& o) {
 }
 
 CVO_HOST_DEVICE inline void clear(PointSums& p) {
-  p.weight = 0.0;
-  p.target[0] = p.target[1] = p.target[2] = 0.0;
+  p.weight = 0.0f;
+  p.offset[0] = p.offset[1] = p.offset[2] = 0.0f;
+  p.pairs = 0;
+}
+
+CVO_HOST_DEVICE inline float floatFromBits(int bits) {
+#if defined(__CUDA_ARCH__)
+  return __int_as_float(bits);
+#else
+  return __builtin_bit_cast(float, bits);  // memcpy here would stop the loop vectoriser
+#endif
+}
+
+// exp(x) for x <= 0, relative error below 3e-7, and 0-ish (2^-126) below -87. Plain arithmetic
+// so that the CPU vectorises it and both backends compute the very same values.
+CVO_HOST_DEVICE inline float expNonPositive(float x) {
+  x = x < -87.0f ? -87.0f : x;
+  // Round x / ln 2 to the nearest integer with the 1.5 * 2^23 trick (no floorf: it blocks SSE2).
+  const float shifter = 12582912.0f;
+  const float n = (x * 1.44269504f + shifter) - shifter;
+  const float r = (x - n * 0.693145751953125f) - n * 1.428606765330187e-06f;  // |r| <= ln2/2
+  float p = 1.0f / 720.0f;
+  p = p * r + 1.0f / 120.0f;
+  p = p * r + 1.0f / 24.0f;
+  p = p * r + 1.0f / 6.0f;
+  p = p * r + 0.5f;
+  p = p * r + 1.0f;
+  p = p * r + 1.0f;
+  return p * floatFromBits((static_cast<int>(n) + 127) << 23);
 }
 
 CVO_HOST_DEVICE inline float squaredDistance(const float* a, const float* b, int dim) {
@@ -86,49 +113,54 @@ CVO_HOST_DEVICE inline float squaredDistance(const float* a, const float* b, int
   return sum;
 }
 
-// s^2 times the appearance factors: the part of a_ij that does not move with the pose.
-// Colour and semantic pointers may be null when that kernel is off.
-CVO_HOST_DEVICE inline float appearanceWeight(const KernelConstants& k, const float* color_x,
-                                              const float* color_z, const float* semantic_x,
-                                              const float* semantic_z) {
-  float w = k.sigma2;
-  if (k.use_color) {
-    w *=
-        k.color_sigma2 * expf(-squaredDistance(color_x, color_z, kColorDim) * k.color_inv_two_ell2);
-  }
+// Scaled appearance distance sum_V |u - v|^2 / ell_V^2 (0 with no appearance kernel). Colour
+// and semantic pointers may be null when that kernel is off.
+CVO_HOST_DEVICE inline float appearanceDistance2(const KernelConstants& k, const float* color_x,
+                                                 const float* color_z, const float* semantic_x,
+                                                 const float* semantic_z) {
+  float d2 = 0.0f;
+  if (k.use_color) d2 += squaredDistance(color_x, color_z, kColorDim) * k.color_inv_ell2;
   if (k.semantic_classes > 0) {
-    w *= k.semantic_sigma2 * expf(-squaredDistance(semantic_x, semantic_z, k.semantic_classes) *
-                                  k.semantic_inv_two_ell2);
+    d2 += squaredDistance(semantic_x, semantic_z, k.semantic_classes) * k.semantic_inv_ell2;
   }
-  return w;
+  return d2;
 }
 
-// a_ij from the pose-independent part and the squared distance of the moved points.
-CVO_HOST_DEVICE inline float pairWeight(float appearance, float distance2, float inv_two_ell2) {
-  return appearance * expf(-distance2 * inv_two_ell2);
+// s^2 times the appearance factors: the part of a_ij that does not move with the pose.
+CVO_HOST_DEVICE inline float appearanceWeight(const KernelConstants& k, float appearance_d2) {
+  return k.max_weight * expNonPositive(-0.5f * appearance_d2);
 }
 
-CVO_HOST_DEVICE inline bool isRetained(float weight, float sp_thres) {
-  return weight > sp_thres;
+// a_ij of a pair if it is retained (a_ij > sp_thres), else 0; (dx, dy, dz) = x - z. Scalar
+// arguments: arrays or pointers here stop GCC from vectorising the CPU pair loop.
+CVO_HOST_DEVICE inline float retainedPairWeight(float appearance, float dx, float dy, float dz,
+                                                float inv_two_ell2, float sp_thres) {
+  const float a = appearance * expNonPositive(-(dx * dx + dy * dy + dz * dz) * inv_two_ell2);
+  return a > sp_thres ? a : 0.0f;
 }
 
-CVO_HOST_DEVICE inline void accumulatePair(PointSums& p, float weight, const float* x) {
-  p.weight += weight;
-  for (int k = 0; k < 3; ++k)
-    p.target[k] += static_cast<double>(weight) * x[k];
+// Adds a pair's weight (0 for a pair not retained) to its source point's sums.
+CVO_HOST_DEVICE inline void accumulatePair(PointSums& p, float a, float dx, float dy, float dz) {
+  p.weight += a;
+  p.offset[0] += a * dx;
+  p.offset[1] += a * dy;
+  p.offset[2] += a * dz;
+  p.pairs += a > 0.0f ? 1u : 0u;
 }
 
-// Folds one source point's neighbour sums into the moments: sum a z = A z, sum a x z^T = X z^T.
-CVO_HOST_DEVICE inline void accumulatePoint(MomentSums& m, const PointSums& p, const float* z,
-                                            unsigned long long pairs) {
-  m.weight += p.weight;
+// Folds one source point's sums into the moments: sum a z = A z, sum a x = sum a (x - z) + A z,
+// sum a x z^T = (sum a x) z^T.
+CVO_HOST_DEVICE inline void accumulatePoint(MomentSums& m, const PointSums& p, const float* z) {
+  const double w = p.weight;
+  m.weight += w;
   for (int r = 0; r < 3; ++r) {
-    m.target[r] += p.target[r];
-    m.source[r] += p.weight * z[r];
+    const double target = static_cast<double>(p.offset[r]) + w * z[r];
+    m.target[r] += target;
+    m.source[r] += w * z[r];
     for (int c = 0; c < 3; ++c)
-      m.cross[3 * r + c] += p.target[r] * z[c];
+      m.cross[3 * r + c] += target * z[c];
   }
-  m.pairs += pairs;
+  m.pairs += p.pairs;
 }
 
 // Moves a point by a row-major 3x4 float transform.

@@ -1,0 +1,42 @@
+#include "cvo_odometry/frontend/semantic_image.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace cvo {
+
+SemanticImage::SemanticImage(const cv::Mat& image, int classes, const std::vector<int>& ignore)
+    : image_(image), classes_(classes), ignore_(ignore) {
+  if (image.empty()) throw std::invalid_argument("segmentation image is empty");
+  if (classes < 1) throw std::invalid_argument("segmentation needs at least one class");
+  const bool ids = image.channels() == 1 && (image.depth() == CV_8U || image.depth() == CV_16U);
+  const bool probs = image.depth() == CV_32F && image.channels() == classes;
+  if (!ids && !probs) {
+    throw std::invalid_argument(
+        "unsupported segmentation image (type " + std::to_string(image.type()) + ", " +
+        std::to_string(image.channels()) + " channels): expected 8/16-bit class ids or " +
+        std::to_string(classes) + " float channels");
+  }
+}
+
+bool SemanticImage::ignored(int cls) const {
+  return std::find(ignore_.begin(), ignore_.end(), cls) != ignore_.end();
+}
+
+bool SemanticImage::probabilities(int u, int v, float* out) const {
+  if (image_.depth() == CV_32F) {
+    const float* p = image_.ptr<float>(v) + static_cast<std::size_t>(classes_) * u;
+    const int best = static_cast<int>(std::max_element(p, p + classes_) - p);
+    if (ignored(best)) return false;
+    std::copy(p, p + classes_, out);
+    return true;
+  }
+  const int cls =
+      image_.depth() == CV_8U ? image_.at<std::uint8_t>(v, u) : image_.at<std::uint16_t>(v, u);
+  if (cls >= classes_ || ignored(cls)) return false;
+  std::fill(out, out + classes_, 0.0f);
+  out[cls] = 1.0f;
+  return true;
+}
+
+}  // namespace cvo

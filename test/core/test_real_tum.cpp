@@ -1,0 +1,110 @@
+// The core on real data: clouds exported from TUM fr1_xyz frames 10 and 11 by the front end
+// (test/data/tum_clouds, see test/data/README.md), with ground truth from groundtruth.txt.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "cvo_odometry/core/cloud_io.hpp"
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/trajectory_io.hpp"
+
+namespace {
+
+const std::string kData = CVO_TEST_DATA_DIR;
+
+// Depth stamp of frame `index` of the fixture (associations.txt: rgb stamp, file, depth stamp).
+double depthStamp(int index) {
+  std::ifstream in(kData + "/tum_fr1_xyz/associations.txt");
+  std::string line;
+  for (int k = 0; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (k++ == index) {
+      std::istringstream ss(line);
+      std::string rgb_stamp, rgb_file;
+      double depth_stamp = 0.0;
+      ss >> rgb_stamp >> rgb_file >> depth_stamp;
+      return depth_stamp;
+    }
+  }
+  throw std::runtime_error("no frame " + std::to_string(index));
+}
+
+// Ground-truth motion target (frame 10) <- source (frame 11), camera frames.
+Eigen::Isometry3d groundTruthMotion() {
+  const auto gt = cvo::readTumTrajectory(kData + "/tum_fr1_xyz/groundtruth.txt");
+  Eigen::Isometry3d g10, g11;
+  EXPECT_TRUE(gt.interpolate(depthStamp(10), 0.02, &g10));
+  EXPECT_TRUE(gt.interpolate(depthStamp(11), 0.02, &g11));
+  return g10.inverse() * g11;
+}
+
+cvo::CvoParams tumParams(bool color) {
+  cvo::CvoParams p;
+  p.backend = cvo::BackendChoice::kCpu;
+  p.use_color = color;
+  return p;
+}
+
+Eigen::Isometry3d perturbed(const Eigen::Isometry3d& T, const Eigen::Vector3d& shift,
+                            double yaw_deg) {
+  Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+  D.translation() = shift;
+  D.linear() =
+      Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  return D * T;
+}
+
+}  // namespace
+
+TEST(RealTum, IndicatorPeaksAtGroundTruthAndFallsWithPerturbation) {
+  const auto target = cvo::readCloud(kData + "/tum_clouds/frame10_3000.cloud");
+  const auto source = cvo::readCloud(kData + "/tum_clouds/frame11_3000.cloud");
+  const Eigen::Isometry3d truth = groundTruthMotion();
+  for (bool color : {false, true}) {
+    cvo::CvoRegistration registration(tumParams(color));
+    const double ell = 0.05;
+    const double at_truth = registration.indicator(target, source, truth, ell);
+    double previous = at_truth;
+    for (double cm : {1.0, 2.0, 4.0, 8.0}) {
+      const double moved =
+          registration.indicator(target, source, perturbed(truth, {cm / 100, 0, 0}, 0), ell);
+      EXPECT_LT(moved, previous) << "colour " << color << ", " << cm << " cm";
+      previous = moved;
+    }
+    previous = at_truth;
+    for (double deg : {1.0, 2.0, 4.0, 8.0}) {
+      const double turned = registration.indicator(target, source, perturbed(truth, {}, deg), ell);
+      EXPECT_LT(turned, previous) << "colour " << color << ", " << deg << " deg";
+      previous = turned;
+    }
+    const double cosine = registration.cosine(target, source, truth, ell);
+    EXPECT_GT(cosine, registration.cosine(target, source, perturbed(truth, {0.04, 0, 0}, 0), ell));
+    EXPECT_GT(cosine, 0.0);
+    EXPECT_LE(cosine, 1.0);
+  }
+}
+
+TEST(RealTum, RegistrationLandsWithinACentimetreAndHalfADegree) {
+  const Eigen::Isometry3d truth = groundTruthMotion();
+  for (const char* size : {"3000", "8000"}) {
+    const auto target = cvo::readCloud(kData + "/tum_clouds/frame10_" + size + ".cloud");
+    const auto source = cvo::readCloud(kData + "/tum_clouds/frame11_" + size + ".cloud");
+    for (bool color : {false, true}) {
+      for (auto method : {cvo::StepMethod::kProcrustes, cvo::StepMethod::kReference}) {
+        if (method == cvo::StepMethod::kReference && std::string(size) != "3000") continue;
+        cvo::CvoParams params = tumParams(color);
+        params.step_method = method;
+        cvo::CvoRegistration registration(params);
+        const auto result = registration.align(target, source, Eigen::Isometry3d::Identity());
+        const Eigen::Isometry3d error = truth.inverse() * result.transform;
+        const std::string what =
+            std::string(size) + (color ? " colour " : " geometric ") + cvo::toString(method);
+        EXPECT_TRUE(result.report.converged) << what << ": " << result.report.message;
+        EXPECT_LT(error.translation().norm(), 0.01) << what;
+        EXPECT_LT(cvo::lie::rotationAngle(error.linear()) * 180.0 / M_PI, 0.5) << what;
+        EXPECT_GT(result.report.indicator_after, result.report.indicator_before) << what;
+      }
+    }
+  }
+}
