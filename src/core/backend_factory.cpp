@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "cvo_odometry/core/cpu_backend.hpp"
+#include "cvo_odometry/core/failover_backend.hpp"
 #ifdef CVO_HAVE_CUDA
 #include "cvo_odometry/core/cuda_backend.hpp"
 #endif
@@ -24,7 +25,13 @@ std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_t
     std::string why_not;
     if (cudaBackendAvailable(&why_not)) {
 #ifdef CVO_HAVE_CUDA
-      return std::make_unique<CudaBackend>(num_threads);
+      try {
+        // A CUDA error later falls back to the CPU for that registration.
+        return std::make_unique<FailoverBackend>(std::make_unique<CudaBackend>(),
+                                                 std::make_unique<CpuBackend>(num_threads));
+      } catch (const std::runtime_error& e) {
+        why_not = e.what();
+      }
 #endif
     }
     if (choice == BackendChoice::kCuda) {

@@ -9,6 +9,7 @@
 
 #include "cvo_odometry/core/backend_factory.hpp"
 #include "cvo_odometry/core/cvo_steps.hpp"
+#include "cvo_odometry/core/failover_backend.hpp"
 
 namespace cvo {
 
@@ -65,6 +66,8 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   target_ = &target;
   source_ = &source;
   stride_ = 0;
+  auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
+  if (failover) failover->restore();  // each registration tries the GPU again
   RegistrationResult result;
   RegistrationReport& report = result.report;
   report.backend = backend_->name();
@@ -81,6 +84,10 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   report.indicator_after =
       backend_->moments(result.transform, report.final_lengthscale).weight / norm;
   report.indicator_before = backend_->moments(guess, report.final_lengthscale).weight / norm;
+  if (failover && failover->failedOver()) {
+    report.backend = failover->name();
+    report.warning = "GPU failed, this registration ran on the CPU: " + failover->lastError();
+  }
   report.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;

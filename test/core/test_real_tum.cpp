@@ -74,7 +74,8 @@ TEST(RealTum, IndicatorPeaksAtGroundTruthAndFallsWithPerturbation) {
     }
     previous = at_truth;
     for (double deg : {1.0, 2.0, 4.0, 8.0}) {
-      const double turned = registration.indicator(target, source, perturbed(truth, {}, deg), ell);
+      const double turned = registration.indicator(
+          target, source, perturbed(truth, Eigen::Vector3d::Zero(), deg), ell);
       EXPECT_LT(turned, previous) << "colour " << color << ", " << deg << " deg";
       previous = turned;
     }

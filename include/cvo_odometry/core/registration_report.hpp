@@ -19,6 +19,7 @@ struct RegistrationReport {
   double time_ms = 0.0;
   std::string backend;
   std::string message;  // why it stopped
+  std::string warning;  // e.g. a GPU failure this registration recovered from
 };
 
 }  // namespace cvo
