@@ -3,10 +3,7 @@
 # (37 frames), trajectory written to build/demo_trajectory.txt, errors against ground truth.
 set -euo pipefail
 source "$(dirname "$0")/env.sh"
-"$CVO_ROOT/scripts/install_deps.sh" full
-mkdir -p "$CVO_BUILD"
-cmake -S "$CVO_ROOT" -B "$CVO_BUILD" -DCMAKE_BUILD_TYPE=Release >"$CVO_BUILD/configure.log" 2>&1 ||
-  { cat "$CVO_BUILD/configure.log"; exit 1; }
+cvo_configure
 cmake --build "$CVO_BUILD" -j"$(cvo_jobs)" --target cvo_run_sequence cvo_evaluate
 data="$CVO_ROOT/test/data/tum_fr1_xyz"
 runner=$(find "$CVO_BUILD" -type f -name cvo_run_sequence -perm -u+x | head -n 1)

@@ -10,6 +10,7 @@
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
+#include "cvo_odometry/tools/tool_options.hpp"
 
 namespace {
 
@@ -31,35 +32,20 @@ cvo::LabeledCloud frameCloud(const cvo::CommandLine& cli, const cvo::TumSequence
 
 int main(int argc, char** argv) {
   try {
-    const cvo::CommandLine cli(
-        argc, argv,
-        {"target-cloud", "source-cloud", "tum", "target", "source", "preset", "set", "camera",
-         "depth-scale", "min-points", "max-points", "selector", "save-target", "save-source"},
-        {"help", "first-frame"});
+    const cvo::CommandLine cli(argc, argv,
+                               {"target-cloud", "source-cloud", "tum", "target", "source", "preset",
+                                "set", "camera", "depth-scale", "min-points", "max-points",
+                                "selector", "save-target", "save-source", "backend"},
+                               {"help", "first-frame"});
     if (cli.has("help")) {
       std::cout << kUsage;
       return 0;
     }
-    cvo::CvoParams params;
-    if (cli.has("preset")) params = cvo::loadCvoParams(cli.get("preset"));
-    if (cli.has("set")) {
-      std::stringstream ss(cli.get("set"));
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        const auto eq = item.find('=');
-        if (eq == std::string::npos) throw std::invalid_argument("--set expects key=value");
-        cvo::setCvoParam(params, item.substr(0, eq), item.substr(eq + 1));
-      }
-    }
+    const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
     cvo::LabeledCloud target, source;
     if (cli.has("tum")) {
       const cvo::TumSequence sequence(cli.get("tum"));
-      cvo::RgbdFrontendOptions options;
-      options.depth_units_per_metre = cli.getDouble("depth-scale", 5000.0);
-      options.selector.kind = cvo::parseSelectorKind(cli.get("selector", "fast"));
-      options.selector.min_points = cli.getInt("min-points", options.selector.min_points);
-      options.selector.max_points = cli.getInt("max-points", options.selector.max_points);
-      cvo::RgbdCloudBuilder builder(options);
+      cvo::RgbdCloudBuilder builder(cvo::rgbdFrontendOptionsFrom(cli));
       target = frameCloud(cli, sequence, builder, std::stoi(cli.require("target")));
       source = frameCloud(cli, sequence, builder, std::stoi(cli.require("source")));
     } else {

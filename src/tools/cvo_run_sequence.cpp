@@ -15,6 +15,7 @@
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/stage_timer.hpp"
+#include "cvo_odometry/tools/tool_options.hpp"
 
 namespace {
 
@@ -32,18 +33,6 @@ const char* kUsage =
     "  --out FILE --format tum|kitti   trajectory output (TUM format)\n"
     "  --gt FILE               ground truth to evaluate against\n"
     "  --quiet                 no per-frame lines\n";
-
-void applyOverrides(cvo::CvoParams& params, const std::string& text) {
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos)
-      throw std::invalid_argument("--set expects key=value, got '" + item + "'");
-    cvo::setCvoParam(params, item.substr(0, eq), item.substr(eq + 1));
-  }
-  params.validate();
-}
 
 void progress(bool tty, std::size_t done, std::size_t total, double fps) {
   if (tty) {
@@ -69,19 +58,11 @@ int main(int argc, char** argv) {
       std::cout << kUsage;
       return 0;
     }
-    cvo::CvoParams params;
-    if (cli.has("preset")) params = cvo::loadCvoParams(cli.get("preset"));
-    if (cli.has("backend")) params.backend = cvo::parseBackendChoice(cli.get("backend"));
-    if (cli.has("set")) applyOverrides(params, cli.get("set"));
+    const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
 
     const cvo::TumSequence sequence(cli.require("tum"));
     const cvo::PinholeIntrinsics intrinsics = cvo::tumIntrinsics(cli.get("camera", "fr1"));
-    cvo::RgbdFrontendOptions frontend;
-    frontend.depth_units_per_metre = cli.getDouble("depth-scale", 5000.0);
-    frontend.selector.kind = cvo::parseSelectorKind(cli.get("selector", "fast"));
-    frontend.selector.min_points = cli.getInt("min-points", frontend.selector.min_points);
-    frontend.selector.max_points = cli.getInt("max-points", frontend.selector.max_points);
-    cvo::RgbdCloudBuilder builder(frontend);
+    cvo::RgbdCloudBuilder builder(cvo::rgbdFrontendOptionsFrom(cli));
     cvo::FrameToFrameOdometry odometry(params);
     const bool stamp_depth = cli.get("stamp", "depth") == "depth";
 
