@@ -166,15 +166,22 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
       kernels::transformPoint(pose, src + 3 * j, z);
       radius_max = std::max(
           radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
-      grid_.forEachWithin(z, radius, [&](std::uint32_t i) {
-        const float geometric = kernels::squaredDistance(tgt + 3 * i, z, 3) * inv_ell2;
-        const float appearance_d2 = kernels::appearanceDistance2(
-            constants_, color ? target_->color(i) : nullptr, color ? source_->color(j) : nullptr,
-            semantic ? target_->semantics(i) : nullptr, semantic ? source_->semantics(j) : nullptr);
-        if (geometric + appearance_d2 >= reach2) return;
-        block.push(i, tgt + 3 * i, kernels::appearanceWeight(constants_, appearance_d2),
-                   appearance_d2);
-      });
+      if (!color && !semantic) {
+        // Geometry only: the grid's radius test is the joint-distance test.
+        grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
+          block.push(i, tgt + 3 * i, constants_.max_weight, 0.0f);
+        });
+      } else {
+        grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
+          const float appearance_d2 = kernels::appearanceDistance2(
+              constants_, color ? target_->color(i) : nullptr, color ? source_->color(j) : nullptr,
+              semantic ? target_->semantics(i) : nullptr,
+              semantic ? source_->semantics(j) : nullptr);
+          if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
+          block.push(i, tgt + 3 * i, kernels::appearanceWeight(constants_, appearance_d2),
+                     appearance_d2);
+        });
+      }
       block.offsets.push_back(static_cast<std::uint32_t>(block.target.size()));
     }
   }

@@ -206,7 +206,7 @@ int CvoRegistration::useCloudsForLengthscale(double ell) {
     // Never below ~500 points a cloud: sparser clouds give too few (colour) pairs to steer by.
     const std::size_t smaller = std::min(target_->size(), source_->size());
     const int most = std::max(1, static_cast<int>(smaller / 500));
-    stride = std::clamp(static_cast<int>(std::lround(ell / params_.ell_min)), 1, most);
+    stride = std::clamp(static_cast<int>(std::ceil(ell / params_.ell_min)), 1, most);
   }
   if (stride != stride_) {
     stride_ = stride;

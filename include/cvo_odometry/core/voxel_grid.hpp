@@ -19,7 +19,8 @@ class VoxelGrid {
 
   float cellSize() const { return cell_size_; }
 
-  // Calls f(index) for every point within `radius` (<= cell size) of p, in a fixed order.
+  // Calls f(index, squared distance) for every point within `radius` (<= cell size) of p, in a
+  // fixed order.
   template <class F>
   void forEachWithin(const float* p, float radius, F&& f) const {
     const float r2 = radius * radius;
@@ -28,7 +29,8 @@ class VoxelGrid {
       for (std::uint32_t k = begin; k < end; ++k) {
         const float* q = sorted_ + 3 * k;
         const float ex = q[0] - p[0], ey = q[1] - p[1], ez = q[2] - p[2];
-        if (ex * ex + ey * ey + ez * ez <= r2) f(order_[k]);
+        const float d2 = ex * ex + ey * ey + ez * ez;
+        if (d2 <= r2) f(order_[k], d2);
       }
     };
     for (int dx = -1; dx <= 1; ++dx) {
