@@ -99,7 +99,6 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
   constant_appearance_ = !constants_.use_color && constants_.semantic_classes == 0;
   cutoff2_ = retainedScaledDistance2(params);
   candidates_valid_ = false;
-  rebuilds_ = 0;
   // Blocks keep their storage across problems: no reallocation (and page faults) per level.
   blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
 }
@@ -110,13 +109,6 @@ int CpuBackend::threadCount() const {
 #else
   return 1;
 #endif
-}
-
-std::size_t CpuBackend::candidatePairs() const {
-  std::size_t n = 0;
-  for (const auto& b : blocks_)
-    n += b.target.size();
-  return n;
 }
 
 double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
@@ -140,7 +132,6 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
 }
 
 void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
-  ++rebuilds_;
   const double reach = std::sqrt(cutoff2_) + kSkin;  // scaled joint distance kept
   const float radius = static_cast<float>(reach * ell);
   grid_.build(target_->positionData().data(), target_->size(), radius);
@@ -300,12 +291,8 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
     partial[b] = s;
   }
   kernels::TaylorSums total{0.0, 0.0, 0.0, 0.0};
-  for (const auto& s : partial) {
-    total.b += s.b;
-    total.c += s.c;
-    total.d += s.d;
-    total.e += s.e;
-  }
+  for (const auto& s : partial)
+    kernels::add(total, s);
   return total;
 }
 

@@ -38,9 +38,7 @@ void CvoParams::validate() const {
     requirePositive(semantic_sigma, "semantic_sigma");
   }
   // The largest possible pair weight must clear the threshold, or no pair is ever retained.
-  double max_weight = sigma * sigma;
-  if (use_color) max_weight *= color_sigma * color_sigma;
-  if (use_semantics) max_weight *= semantic_sigma * semantic_sigma;
+  const double max_weight = maxKernelWeight();
   require(max_weight > sp_thres, "sp_thres (" + std::to_string(sp_thres) +
                                      ") is not below the largest kernel product (" +
                                      std::to_string(max_weight) + "): no pair could count");
@@ -62,6 +60,13 @@ void CvoParams::validate() const {
   require(max_iterations >= 1, "max_iterations must be >= 1");
   require(max_level_iterations >= 1, "max_level_iterations must be >= 1");
   require(num_threads >= 0, "num_threads must be >= 0");
+}
+
+double CvoParams::maxKernelWeight() const {
+  double weight = sigma * sigma;
+  if (use_color) weight *= color_sigma * color_sigma;
+  if (use_semantics) weight *= semantic_sigma * semantic_sigma;
+  return weight;
 }
 
 std::string toString(StepMethod method) {

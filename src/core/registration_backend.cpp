@@ -5,18 +5,12 @@
 namespace cvo {
 
 double retainedScaledDistance2(const CvoParams& params) {
-  double max_weight = params.sigma * params.sigma;
-  if (params.use_color) max_weight *= params.color_sigma * params.color_sigma;
-  if (params.use_semantics) max_weight *= params.semantic_sigma * params.semantic_sigma;
-  return 2.0 * std::log(max_weight / params.sp_thres);
+  return 2.0 * std::log(params.maxKernelWeight() / params.sp_thres);
 }
 
 kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semantic_classes) {
   kernels::KernelConstants k{};
-  double max_weight = params.sigma * params.sigma;
-  if (params.use_color) max_weight *= params.color_sigma * params.color_sigma;
-  if (params.use_semantics) max_weight *= params.semantic_sigma * params.semantic_sigma;
-  k.max_weight = static_cast<float>(max_weight);
+  k.max_weight = static_cast<float>(params.maxKernelWeight());
   k.sp_thres = static_cast<float>(params.sp_thres);
   k.use_color = params.use_color ? 1 : 0;
   k.color_inv_ell2 = static_cast<float>(1.0 / (params.color_ell * params.color_ell));

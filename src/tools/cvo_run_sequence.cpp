@@ -34,15 +34,14 @@ const char* kUsage =
     "  --gt FILE               ground truth to evaluate against\n"
     "  --quiet                 no per-frame lines\n";
 
-void progress(bool tty, std::size_t done, std::size_t total, double fps) {
-  if (tty) {
-    const int width = 30;
-    const int filled = static_cast<int>(width * done / std::max<std::size_t>(total, 1));
-    std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, ' ') << "] "
-              << done << "/" << total << "  " << std::fixed << std::setprecision(1) << fps
-              << " frames/s" << std::flush;
-    if (done == total) std::cerr << "\n";
-  }
+// A progress bar on the terminal (stderr).
+void progress(std::size_t done, std::size_t total, double fps) {
+  const int width = 30;
+  const int filled = static_cast<int>(width * done / std::max<std::size_t>(total, 1));
+  std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, ' ') << "] " << done
+            << "/" << total << "  " << std::fixed << std::setprecision(1) << fps << " frames/s"
+            << std::flush;
+  if (done == total) std::cerr << "\n";
 }
 
 }  // namespace
@@ -98,7 +97,7 @@ int main(int argc, char** argv) {
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (tty) {
-        progress(true, done, last - first + 1, done / elapsed);
+        progress(done, last - first + 1, done / elapsed);
       } else if (!cli.has("quiet")) {
         std::cerr << "frame " << k << ": " << stats.selection.selected << " points (FAST "
                   << stats.selection.fast_threshold << ")";

@@ -23,10 +23,6 @@ class CpuBackend : public RegistrationBackend {
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
 
-  // Number of candidate-list rebuilds since setProblem (for the benchmark).
-  int rebuilds() const { return rebuilds_; }
-  std::size_t candidatePairs() const;
-
  private:
   // Candidate pairs of one block of source points, CSR layout.
   struct Block {
@@ -65,7 +61,6 @@ class CpuBackend : public RegistrationBackend {
   double margin_ = 0.0;  // lists hold every pair within sqrt(cutoff) + margin
   Eigen::Isometry3d built_pose_ = Eigen::Isometry3d::Identity();
   double built_radius_ = 0.0;  // largest |T_built z|: bounds how far a rotation moves a point
-  int rebuilds_ = 0;
 };
 
 }  // namespace cvo

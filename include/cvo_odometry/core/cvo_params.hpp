@@ -61,6 +61,8 @@ struct CvoParams {
 
   // Throws std::invalid_argument naming the first parameter that makes no sense.
   void validate() const;
+  // The largest pair weight: s^2 times s_V^2 of every appearance kernel in use.
+  double maxKernelWeight() const;
 };
 
 std::string toString(StepMethod method);

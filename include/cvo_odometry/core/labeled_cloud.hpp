@@ -11,11 +11,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/pair_kernels.hpp"
+
 namespace cvo {
 
 class LabeledCloud {
  public:
-  static constexpr int kColorDim = 5;
+  static constexpr int kColorDim = kernels::kColorDim;
 
   LabeledCloud() = default;
   // `semantic_classes` = 0 for a cloud without semantics.

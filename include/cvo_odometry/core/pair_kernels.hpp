@@ -72,6 +72,13 @@ CVO_HOST_DEVICE inline void add(MomentSums& m, const MomentSums& o) {
   m.pairs += o.pairs;
 }
 
+CVO_HOST_DEVICE inline void add(TaylorSums& s, const TaylorSums& o) {
+  s.b += o.b;
+  s.c += o.c;
+  s.d += o.d;
+  s.e += o.e;
+}
+
 CVO_HOST_DEVICE inline void clear(PointSums& p) {
   p.weight = 0.0f;
   p.offset[0] = p.offset[1] = p.offset[2] = 0.0f;

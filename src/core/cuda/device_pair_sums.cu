@@ -141,12 +141,8 @@ __global__ void taylorKernel(CloudView target, CloudView source, GridView grid,
       if (a > 0.0f) kernels::accumulateTaylorPair(mine, frame, x, z, a, inv_ell2);
     });
   }
-  blockReduce(shared, mine, [](kernels::TaylorSums& a, const kernels::TaylorSums& b) {
-    a.b += b.b;
-    a.c += b.c;
-    a.d += b.d;
-    a.e += b.e;
-  });
+  blockReduce(shared, mine,
+              [](kernels::TaylorSums& a, const kernels::TaylorSums& b) { kernels::add(a, b); });
   if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
 }
 
@@ -301,6 +297,30 @@ struct DevicePairSums::Impl {
     sorted[2].reserve(static_cast<std::size_t>(classes) * n);
   }
 
+  // Grid for this lengthscale (rebuilt when it changed) and the pose on the device; returns the
+  // number of blocks, one source point a thread.
+  int prepare(const float* host_pose, double ell) {
+    const double radius = std::sqrt(cutoff2) * ell;
+    if (grid_cell != radius) buildGrid(radius);
+    check(cudaMemcpyAsync(pose.data, host_pose, 12 * sizeof(float), cudaMemcpyHostToDevice, stream),
+          "upload pose");
+    return std::max(1, (count[1] + kThreads - 1) / kThreads);
+  }
+
+  // Downloads the per-block partial sums and adds them in block order (deterministic).
+  template <class Sums>
+  Sums sumPartials(const DeviceBuffer<Sums>& partials, std::vector<Sums>& host, int blocks) {
+    host.resize(blocks);
+    check(cudaMemcpyAsync(host.data(), partials.data, blocks * sizeof(Sums), cudaMemcpyDeviceToHost,
+                          stream),
+          "download partial sums");
+    check(cudaStreamSynchronize(stream), "sums sync");
+    Sums total{};
+    for (const Sums& partial : host)
+      kernels::add(total, partial);
+    return total;
+  }
+
   CloudView targetView() const {
     return {sorted[0].data, sorted[1].data, sorted[2].data, count[0]};
   }
@@ -346,55 +366,26 @@ void DevicePairSums::setConstants(const kernels::KernelConstants& constants, dou
 
 kernels::MomentSums DevicePairSums::moments(const float* pose, double ell) {
   Impl& d = *impl_;
-  const double radius = std::sqrt(d.cutoff2) * ell;
-  if (d.grid_cell != radius) d.buildGrid(radius);
-  const int blocks = std::max(1, (d.count[1] + kThreads - 1) / kThreads);
+  const int blocks = d.prepare(pose, ell);
   d.moment_partials.reserve(blocks);
-  check(cudaMemcpyAsync(d.pose.data, pose, 12 * sizeof(float), cudaMemcpyHostToDevice, d.stream),
-        "upload pose");
   momentsKernel<<<blocks, kThreads, 0, d.stream>>>(
       d.targetView(), d.sourceView(), d.grid, d.constants, d.pose.data,
       static_cast<float>(0.5 / (ell * ell)), d.moment_partials.data);
   check(cudaGetLastError(), "moments kernel");
-  d.host_moments.resize(blocks);
-  check(cudaMemcpyAsync(d.host_moments.data(), d.moment_partials.data,
-                        blocks * sizeof(kernels::MomentSums), cudaMemcpyDeviceToHost, d.stream),
-        "download moments");
-  check(cudaStreamSynchronize(d.stream), "moments sync");
-  kernels::MomentSums total;
-  kernels::clear(total);
-  for (const auto& m : d.host_moments)
-    kernels::add(total, m);  // fixed order
-  return total;
+  return d.sumPartials(d.moment_partials, d.host_moments, blocks);
 }
 
 kernels::TaylorSums DevicePairSums::taylor(const float* pose, const double* xi, double ell) {
   Impl& d = *impl_;
-  const double radius = std::sqrt(d.cutoff2) * ell;
-  if (d.grid_cell != radius) d.buildGrid(radius);
-  const int blocks = std::max(1, (d.count[1] + kThreads - 1) / kThreads);
+  const int blocks = d.prepare(pose, ell);
   d.taylor_partials.reserve(blocks);
-  check(cudaMemcpyAsync(d.pose.data, pose, 12 * sizeof(float), cudaMemcpyHostToDevice, d.stream),
-        "upload pose");
   check(cudaMemcpyAsync(d.xi.data, xi, 6 * sizeof(double), cudaMemcpyHostToDevice, d.stream),
         "upload twist");
   taylorKernel<<<blocks, kThreads, 0, d.stream>>>(
       d.targetView(), d.sourceView(), d.grid, d.constants, d.pose.data, d.xi.data,
       static_cast<float>(0.5 / (ell * ell)), 1.0 / (ell * ell), d.taylor_partials.data);
   check(cudaGetLastError(), "taylor kernel");
-  d.host_taylor.resize(blocks);
-  check(cudaMemcpyAsync(d.host_taylor.data(), d.taylor_partials.data,
-                        blocks * sizeof(kernels::TaylorSums), cudaMemcpyDeviceToHost, d.stream),
-        "download taylor");
-  check(cudaStreamSynchronize(d.stream), "taylor sync");
-  kernels::TaylorSums total{0.0, 0.0, 0.0, 0.0};
-  for (const auto& s : d.host_taylor) {
-    total.b += s.b;
-    total.c += s.c;
-    total.d += s.d;
-    total.e += s.e;
-  }
-  return total;
+  return d.sumPartials(d.taylor_partials, d.host_taylor, blocks);
 }
 
 bool cudaDeviceUsable(std::string* why_not) {
