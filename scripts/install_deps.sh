@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cvo_odometry needs; quick and quiet when they are all present.
-# Usage: scripts/install_deps.sh [core|full]   (core: CMake, compiler, Eigen, GoogleTest only)
+# Usage: scripts/install_deps.sh [core|full|peers]
+#   core: CMake, compiler, Eigen, GoogleTest; full: + OpenCV and ROS; peers: + PCL, Open3D, contrib
 set -euo pipefail
 profile=${1:-full}
 
@@ -10,12 +11,18 @@ full=("${core[@]}" libopencv-dev clang-format
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libnodeletlib-dev libnodelet-dev
   libnodeletlib-tools libmessage-filters-dev libtf2-ros-dev libdynamic-reconfigure-config-init-mutex-dev
   python3-dynamic-reconfigure librostest-dev python3-rostest python3-roslaunch rosout rosbash
-  rospack-tools librosbag-dev python3-rosbag python3-sensor-msgs python3-nav-msgs python3-tf2-msgs)
+  rospack-tools librosbag-dev python3-rosbag python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
+  ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-stereo-msgs libstereo-msgs-dev
+  libcv-bridge-dev libimage-transport-dev libdiagnostic-updater-dev libdiagnostic-msgs-dev
+  ros-diagnostic-msgs libstereo-image-proc-dev ros-stereo-image-proc python3-matplotlib)
+# Peers for bench/peer_table.sh only (large: PCL, Open3D, OpenCV contrib).
+peers=(libopencv-contrib-dev libpcl-dev python3-open3d python3-numpy)
 
 case "$profile" in
   core) wanted=("${core[@]}") ;;
   full) wanted=("${full[@]}") ;;
-  *) echo "usage: $0 [core|full]" >&2; exit 2 ;;
+  peers) wanted=("${full[@]}" "${peers[@]}") ;;
+  *) echo "usage: $0 [core|full|peers]" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -1,5 +1,6 @@
 #include "cvo_odometry/core/params_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -116,8 +117,8 @@ std::vector<std::string> cvoParamNames() {
   return names;
 }
 
-CvoParams parseCvoParams(std::istream& in, const std::string& source_name, const CvoParams& base) {
-  CvoParams params = base;
+void parseKeyValueLines(std::istream& in, const std::string& source_name,
+                        const std::function<void(const std::string&, const std::string&)>& apply) {
   std::set<std::string> seen;
   std::string line;
   int line_no = 0;
@@ -133,11 +134,26 @@ CvoParams parseCvoParams(std::istream& in, const std::string& source_name, const
     const std::string value = unquote(trim(content.substr(colon + 1)));
     if (!seen.insert(key).second) throw FormatError(where + "'" + key + "' given twice");
     try {
-      setCvoParam(params, key, value);
+      apply(key, value);
     } catch (const std::invalid_argument& e) {
       throw FormatError(where + e.what());
     }
   }
+}
+
+const std::vector<std::string>& frontendPresetKeys() {
+  static const std::vector<std::string> keys{"point_selector", "min_points", "max_points",
+                                             "min_depth",      "max_depth",  "crop_top_rows"};
+  return keys;
+}
+
+CvoParams parseCvoParams(std::istream& in, const std::string& source_name, const CvoParams& base) {
+  CvoParams params = base;
+  const auto& skipped = frontendPresetKeys();
+  parseKeyValueLines(in, source_name, [&](const std::string& key, const std::string& value) {
+    if (std::find(skipped.begin(), skipped.end(), key) != skipped.end()) return;
+    setCvoParam(params, key, value);
+  });
   try {
     params.validate();
   } catch (const std::invalid_argument& e) {

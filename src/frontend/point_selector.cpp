@@ -21,6 +21,10 @@ std::vector<cv::Point> thinEvenly(std::vector<cv::Point> pixels, std::size_t cou
   return out;
 }
 
+bool rowMajor(const cv::Point& a, const cv::Point& b) {
+  return a.y != b.y ? a.y < b.y : a.x < b.x;
+}
+
 }  // namespace
 
 PointSelector::PointSelector(const SelectorOptions& options)
@@ -37,7 +41,8 @@ PointSelector::PointSelector(const SelectorOptions& options)
 SelectorKind parseSelectorKind(const std::string& name) {
   if (name == "fast") return SelectorKind::kFast;
   if (name == "grid") return SelectorKind::kGrid;
-  throw std::invalid_argument("unknown point selector '" + name + "' (fast or grid)");
+  if (name == "mixed") return SelectorKind::kMixed;
+  throw std::invalid_argument("unknown point selector '" + name + "' (fast, grid or mixed)");
 }
 
 std::vector<cv::Point> PointSelector::fastPixels(const cv::Mat& grey, const cv::Mat& valid,
@@ -50,15 +55,44 @@ std::vector<cv::Point> PointSelector::fastPixels(const cv::Mat& grey, const cv::
     const cv::Point p(static_cast<int>(kp.pt.x), static_cast<int>(kp.pt.y));
     if (valid.at<std::uint8_t>(p)) pixels.push_back(p);
   }
-  std::sort(pixels.begin(), pixels.end(), [](const cv::Point& a, const cv::Point& b) {
-    return a.y != b.y ? a.y < b.y : a.x < b.x;
-  });
+  std::sort(pixels.begin(), pixels.end(), rowMajor);
   return pixels;
 }
 
-std::vector<cv::Point> PointSelector::gridPixels(const cv::Mat& valid) const {
+std::vector<cv::Point> PointSelector::adaptiveFastPixels(const cv::Mat& grey, const cv::Mat& valid,
+                                                         std::size_t lo, std::size_t hi,
+                                                         int* used_threshold) {
+  // Walk the threshold towards the range; keep the attempt whose count is nearest to it.
+  std::vector<cv::Point> pixels;
+  std::size_t best_distance = SIZE_MAX;
+  int direction = 0;
+  for (int attempt = 0; attempt < options_.max_fast_attempts; ++attempt) {
+    auto candidate = fastPixels(grey, valid, threshold_);
+    const std::size_t n = candidate.size();
+    const std::size_t distance = n < lo ? lo - n : (n > hi ? n - hi : 0);
+    if (distance < best_distance) {
+      best_distance = distance;
+      pixels = std::move(candidate);
+      *used_threshold = threshold_;
+    }
+    if (distance == 0) break;
+    const int step = n < lo ? -1 : 1;
+    if (direction != 0 && step != direction) break;  // overshot the range: take the best
+    direction = step;
+    // Bigger strides far from the range: the count falls roughly geometrically in the threshold.
+    const double ratio = n < lo ? static_cast<double>(lo) / std::max<std::size_t>(n, 1)
+                                : static_cast<double>(n) / hi;
+    const int stride = ratio > 2.0 ? 3 : 1;
+    const int next = std::clamp(threshold_ + step * stride, 1, 254);
+    if (next == threshold_) break;
+    threshold_ = next;
+  }
+  threshold_ = *used_threshold;
+  return pixels;
+}
+
+std::vector<cv::Point> PointSelector::gridPixels(const cv::Mat& valid, double target) const {
   const int valid_count = cv::countNonZero(valid);
-  const double target = 0.5 * (options_.min_points + options_.max_points);
   const int stride = std::max(1, static_cast<int>(std::floor(std::sqrt(valid_count / target))));
   std::vector<cv::Point> pixels;
   for (int v = stride / 2; v < valid.rows; v += stride) {
@@ -76,38 +110,22 @@ std::vector<cv::Point> PointSelector::select(const cv::Mat& grey, const cv::Mat&
   if (grey.type() != CV_8UC1 || valid.type() != CV_8UC1 || grey.size() != valid.size()) {
     throw std::invalid_argument("point selection needs an 8-bit grey image and a mask of its size");
   }
+  const std::size_t lo = static_cast<std::size_t>(options_.min_points);
+  const std::size_t hi = static_cast<std::size_t>(options_.max_points);
+  const double middle = 0.5 * static_cast<double>(lo + hi);
   std::vector<cv::Point> pixels;
   int used_threshold = 0;
   if (options_.kind == SelectorKind::kGrid) {
-    pixels = gridPixels(valid);
+    pixels = gridPixels(valid, middle);
+  } else if (options_.kind == SelectorKind::kFast) {
+    pixels = adaptiveFastPixels(grey, valid, lo, hi, &used_threshold);
   } else {
-    // Walk the threshold towards the range; keep the attempt whose count is nearest to it.
-    std::size_t best_distance = SIZE_MAX;
-    int direction = 0;
-    for (int attempt = 0; attempt < options_.max_fast_attempts; ++attempt) {
-      auto candidate = fastPixels(grey, valid, threshold_);
-      const std::size_t n = candidate.size();
-      const std::size_t lo = static_cast<std::size_t>(options_.min_points);
-      const std::size_t hi = static_cast<std::size_t>(options_.max_points);
-      const std::size_t distance = n < lo ? lo - n : (n > hi ? n - hi : 0);
-      if (distance < best_distance) {
-        best_distance = distance;
-        pixels = std::move(candidate);
-        used_threshold = threshold_;
-      }
-      if (distance == 0) break;
-      const int step = n < lo ? -1 : 1;
-      if (direction != 0 && step != direction) break;  // overshot the range: take the best
-      direction = step;
-      // Bigger strides far from the range: the count falls roughly geometrically in the threshold.
-      const double ratio = n < lo ? static_cast<double>(lo) / std::max<std::size_t>(n, 1)
-                                  : static_cast<double>(n) / hi;
-      const int stride = ratio > 2.0 ? 3 : 1;
-      const int next = std::clamp(threshold_ + step * stride, 1, 254);
-      if (next == threshold_) break;
-      threshold_ = next;
-    }
-    threshold_ = used_threshold;
+    // Half the budget on corners (appearance), half on a grid (geometry everywhere).
+    pixels = adaptiveFastPixels(grey, valid, lo / 2, hi / 2, &used_threshold);
+    const auto grid = gridPixels(valid, middle / 2);
+    pixels.insert(pixels.end(), grid.begin(), grid.end());
+    std::sort(pixels.begin(), pixels.end(), rowMajor);
+    pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
   }
   if (stats) {
     stats->candidates = pixels.size();

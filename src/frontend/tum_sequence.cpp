@@ -1,13 +1,12 @@
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "cvo_odometry/core/format_error.hpp"
+#include "cvo_odometry/frontend/dataset_files.hpp"
 
 namespace cvo {
 
@@ -18,58 +17,23 @@ struct Listing {
   std::string file;
 };
 
-bool fileExists(const std::string& path) {
-  return std::ifstream(path).good();
-}
-
-// Lines of `path` split in whitespace-separated fields, comments and blanks skipped; each line
-// must have `fields` fields.
-std::vector<std::vector<std::string>> readFields(const std::string& path, std::size_t fields) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open '" + path + "'");
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    std::istringstream ss(line);
-    std::vector<std::string> row;
-    std::string field;
-    while (ss >> field)
-      row.push_back(field);
-    if (row.empty() || row[0][0] == '#') continue;
-    if (row.size() != fields) {
-      throw FormatError(path + ":" + std::to_string(line_no) + ": expected " +
-                        std::to_string(fields) + " fields, got " + std::to_string(row.size()));
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-double parseStamp(const std::string& text, const std::string& path) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (*end != '\0' || !std::isfinite(v)) throw FormatError(path + ": bad timestamp '" + text + "'");
-  return v;
-}
-
 }  // namespace
 
 TumSequence::TumSequence(const std::string& folder, double max_gap) : folder_(folder) {
   const std::string associations = folder + "/associations.txt";
   if (fileExists(associations)) {
-    for (const auto& row : readFields(associations, 4)) {
-      frames_.push_back({parseStamp(row[0], associations), parseStamp(row[2], associations),
-                         folder + "/" + row[1], folder + "/" + row[3]});
+    for (const auto& row : readFieldRows(associations, 4)) {
+      frames_.push_back({parseFiniteNumber(row[0], associations),
+                         parseFiniteNumber(row[2], associations), folder + "/" + row[1],
+                         folder + "/" + row[3]});
     }
   } else {
     std::vector<Listing> rgb, depth;
-    for (const auto& row : readFields(folder + "/rgb.txt", 2)) {
-      rgb.push_back({parseStamp(row[0], "rgb.txt"), row[1]});
+    for (const auto& row : readFieldRows(folder + "/rgb.txt", 2)) {
+      rgb.push_back({parseFiniteNumber(row[0], "rgb.txt"), row[1]});
     }
-    for (const auto& row : readFields(folder + "/depth.txt", 2)) {
-      depth.push_back({parseStamp(row[0], "depth.txt"), row[1]});
+    for (const auto& row : readFieldRows(folder + "/depth.txt", 2)) {
+      depth.push_back({parseFiniteNumber(row[0], "depth.txt"), row[1]});
     }
     for (const auto& r : rgb) {
       const Listing* best = nullptr;

@@ -1,5 +1,5 @@
-// cvo_align: registers two clouds (cloud files, or two frames of a TUM folder) and prints the
-// transform (target <- source) and the registration report; can save the clouds it built.
+// cvo_align: registers two clouds (cloud files, or two frames of a TUM or KITTI folder) and prints
+// the transform (target <- source) and the registration report; can save the clouds it built.
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -7,47 +7,35 @@
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/params_io.hpp"
-#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
-#include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
 
 namespace {
 
 const char* kUsage =
-    "usage: cvo_align (--target-cloud F --source-cloud F | --tum DIR --target I --source J)\n"
-    "  --preset FILE --set k=v,...   parameters\n"
-    "  --camera NAME --depth-scale N --min-points N --max-points N --selector fast|grid\n"
+    "usage: cvo_align (--target-cloud F --source-cloud F | --tum|--kitti DIR --target I --source "
+    "J)\n"
     "  --save-target F --save-source F   write the clouds built from the frames\n"
     "  --first-frame                 use the first-frame lengthscale (identity guess)\n";
-
-cvo::LabeledCloud frameCloud(const cvo::CommandLine& cli, const cvo::TumSequence& sequence,
-                             cvo::RgbdCloudBuilder& builder, int index) {
-  cv::Mat image, depth;
-  sequence.load(static_cast<std::size_t>(index), &image, &depth);
-  return builder.build({image, depth, cvo::tumIntrinsics(cli.get("camera", "fr1")), cv::Mat()});
-}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
-    const cvo::CommandLine cli(argc, argv,
-                               {"target-cloud", "source-cloud", "tum", "target", "source", "preset",
-                                "set", "camera", "depth-scale", "min-points", "max-points",
-                                "selector", "save-target", "save-source", "backend"},
-                               {"help", "first-frame"});
+    auto names = cvo::sharedOptionNames();
+    names.insert(names.end(), {"target-cloud", "source-cloud", "target", "source", "save-target",
+                               "save-source"});
+    const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "first-frame"});
     if (cli.has("help")) {
-      std::cout << kUsage;
+      std::cout << kUsage << cvo::kSharedOptionsUsage;
       return 0;
     }
     const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
     cvo::LabeledCloud target, source;
-    if (cli.has("tum")) {
-      const cvo::TumSequence sequence(cli.get("tum"));
-      cvo::RgbdCloudBuilder builder(cvo::rgbdFrontendOptionsFrom(cli));
-      target = frameCloud(cli, sequence, builder, std::stoi(cli.require("target")));
-      source = frameCloud(cli, sequence, builder, std::stoi(cli.require("source")));
+    if (cli.has("tum") || cli.has("kitti")) {
+      const cvo::SequenceInput input = cvo::openSequence(cli);
+      target = input.cloud(static_cast<std::size_t>(std::stoi(cli.require("target"))), nullptr);
+      source = input.cloud(static_cast<std::size_t>(std::stoi(cli.require("source"))), nullptr);
     } else {
       target = cvo::readCloud(cli.require("target-cloud"));
       source = cvo::readCloud(cli.require("source-cloud"));

@@ -1,37 +1,28 @@
-// cvo_run_sequence: frame-to-frame CVO odometry over a recorded TUM RGB-D folder, with the
-// trajectory written out and, given ground truth, evaluated.
+// cvo_run_sequence: frame-to-frame CVO odometry over a recorded TUM RGB-D or KITTI stereo folder,
+// with the trajectory written out and, given ground truth, evaluated (and plotted).
 #include <unistd.h>
 
 #include <chrono>
 #include <iomanip>
 #include <iostream>
-#include <sstream>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/frame_to_frame_odometry.hpp"
-#include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
-#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
-#include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/stage_timer.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
+#include "cvo_odometry/tools/trajectory_plot.hpp"
 
 namespace {
 
 const char* kUsage =
-    "usage: cvo_run_sequence --tum DIR [options]\n"
-    "  --preset FILE           CVO parameters (config/tum_rgbd.yaml)\n"
-    "  --set k=v[,k=v...]      override parameters of the preset\n"
-    "  --camera NAME           fr1 | fr2 | fr3 | fx,fy,cx,cy[,k1,k2,p1,p2,k3] (fr1)\n"
-    "  --depth-scale N         depth PNG units per metre (5000)\n"
-    "  --selector fast|grid    point selection (fast)\n"
-    "  --min-points N --max-points N   selected point range (3000, 15000)\n"
-    "  --backend auto|cpu|cuda\n"
+    "usage: cvo_run_sequence (--tum DIR | --kitti DIR) [options]\n"
     "  --first N --last N      frame range (0 .. all)\n"
-    "  --stamp depth|rgb       which image time stamps the pose (depth)\n"
-    "  --out FILE --format tum|kitti   trajectory output (TUM format)\n"
-    "  --gt FILE               ground truth to evaluate against\n"
+    "  --out FILE --format tum|kitti   trajectory output (TUM for --tum, KITTI for --kitti)\n"
+    "  --gt FILE               ground truth (TUM, or KITTI poses stamped by times.txt)\n"
+    "  --drift-lengths L,...   drift sub-sequence lengths in m (KITTI: 100,...,800)\n"
+    "  --plot FILE.png         estimated vs ground-truth trajectory, seen from above\n"
     "  --quiet                 no per-frame lines\n";
 
 // A progress bar on the terminal (stderr).
@@ -48,31 +39,25 @@ void progress(std::size_t done, std::size_t total, double fps) {
 
 int main(int argc, char** argv) {
   try {
-    const cvo::CommandLine cli(
-        argc, argv,
-        {"tum", "preset", "set", "camera", "depth-scale", "selector", "min-points", "max-points",
-         "backend", "first", "last", "stamp", "out", "format", "gt"},
-        {"help", "quiet"});
+    auto names = cvo::sharedOptionNames();
+    names.insert(names.end(), {"first", "last", "out", "format", "gt", "drift-lengths", "plot"});
+    const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "quiet"});
     if (cli.has("help")) {
-      std::cout << kUsage;
+      std::cout << kUsage << cvo::kSharedOptionsUsage;
       return 0;
     }
     const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
-
-    const cvo::TumSequence sequence(cli.require("tum"));
-    const cvo::PinholeIntrinsics intrinsics = cvo::tumIntrinsics(cli.get("camera", "fr1"));
-    cvo::RgbdCloudBuilder builder(cvo::rgbdFrontendOptionsFrom(cli));
+    const cvo::SequenceInput input = cvo::openSequence(cli);
     cvo::FrameToFrameOdometry odometry(params);
-    const bool stamp_depth = cli.get("stamp", "depth") == "depth";
 
-    const std::size_t total = sequence.frames().size();
+    const std::size_t total = input.stamps.size();
     const std::size_t first = static_cast<std::size_t>(cli.getInt("first", 0));
     const std::size_t last = std::min(
         total - 1, static_cast<std::size_t>(cli.getInt("last", static_cast<int>(total) - 1)));
     if (first > last) throw std::invalid_argument("--first is after --last");
     const bool tty = isatty(STDERR_FILENO) && !cli.has("quiet");
-    std::cerr << "cvo_run_sequence: " << (last - first + 1) << " frames, backend "
-              << odometry.registration().backend().name() << ", step "
+    std::cerr << "cvo_run_sequence: " << input.kind << ", " << (last - first + 1)
+              << " frames, backend " << odometry.registration().backend().name() << ", step "
               << cvo::toString(params.step_method) << ", colour "
               << (params.use_color ? "on" : "off") << "\n";
 
@@ -80,15 +65,11 @@ int main(int argc, char** argv) {
     cvo::StageTimer timer;
     const auto start = std::chrono::steady_clock::now();
     for (std::size_t k = first; k <= last; ++k) {
-      cv::Mat image, depth;
-      sequence.load(k, &image, &depth);
       cvo::FrontendStats stats;
-      cvo::LabeledCloud cloud = builder.build({image, depth, intrinsics, cv::Mat()}, &stats);
+      cvo::LabeledCloud cloud = input.cloud(k, &stats);
       timer.add("frontend", stats.time_ms);
-      const auto& f = sequence.frames()[k];
-      const double stamp = stamp_depth ? f.depth_stamp : f.rgb_stamp;
-      const cvo::OdometryUpdate update = odometry.process(stamp, std::move(cloud));
-      trajectory.append(stamp, update.pose);
+      const cvo::OdometryUpdate update = odometry.process(input.stamps[k], std::move(cloud));
+      trajectory.append(input.stamps[k], update.pose);
       if (!update.first_frame) {
         timer.add("registration", update.report.time_ms);
         timer.add("total", update.report.time_ms + stats.time_ms);
@@ -111,15 +92,28 @@ int main(int argc, char** argv) {
     }
     timer.print(std::cout);
     if (cli.has("out")) {
-      cvo::writeTrajectory(cli.get("out"), trajectory,
-                           cvo::parseTrajectoryFormat(cli.get("format", "tum")));
+      const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))
+                                            : input.trajectory_format;
+      cvo::writeTrajectory(cli.get("out"), trajectory, format);
       std::cout << "trajectory: " << cli.get("out") << "\n";
     }
     if (cli.has("gt")) {
+      const std::string gt_path = cli.get("gt");
+      const auto gt_format = cvo::detectTrajectoryFormat(gt_path);
+      const cvo::Trajectory ground_truth = cvo::readTrajectory(
+          gt_path, gt_format, gt_format == cvo::TrajectoryFormat::kKitti ? input.times_path : "");
       cvo::EvaluationOptions options;
-      const auto report =
-          cvo::evaluateTrajectory(cvo::readTumTrajectory(cli.get("gt")), trajectory, options);
+      options.drift_lengths_m = cli.getDoubleList("drift-lengths", options.drift_lengths_m);
+      const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options);
       cvo::printEvaluationReport(std::cout, report, options);
+      if (cli.has("plot")) {
+        cvo::plotTrajectories(cli.get("plot"), ground_truth, trajectory, report.ate.alignment,
+                              "cvo_odometry " + input.kind);
+        std::cout << "plot: " << cli.get("plot") << "\n";
+      }
+    } else if (cli.has("plot")) {
+      cvo::plotTrajectories(cli.get("plot"), cvo::Trajectory(), trajectory,
+                            Eigen::Isometry3d::Identity(), "cvo_odometry " + input.kind);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 // as ROS parameters), and back to text for logging the effective values.
 #pragma once
 
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -15,9 +16,19 @@ namespace cvo {
 void setCvoParam(CvoParams& params, const std::string& key, const std::string& value);
 std::vector<std::string> cvoParamNames();
 
-// Parses "key: value" lines ('#' comments, blank lines); unknown keys, bad values and duplicate
-// keys throw FormatError naming the source and line. Keys not in the text keep `base`'s values.
-// The result is validated.
+// Reads "key: value" lines ('#' comments, blank lines) and calls `apply` for each; a malformed
+// line, a duplicate key, or std::invalid_argument from `apply` throws FormatError naming the
+// source and line.
+void parseKeyValueLines(std::istream& in, const std::string& source_name,
+                        const std::function<void(const std::string&, const std::string&)>& apply);
+
+// The keys a preset may carry for the front end (point_selector, min_points, max_points,
+// min_depth, max_depth, crop_top_rows): the front end reads them, the core skips them.
+const std::vector<std::string>& frontendPresetKeys();
+
+// CvoParams from a preset; unknown keys and bad values throw FormatError naming the source and
+// line. The front end's keys are skipped. Keys not in the text keep `base`'s values. The result
+// is validated.
 CvoParams parseCvoParams(std::istream& in, const std::string& source_name,
                          const CvoParams& base = CvoParams());
 CvoParams loadCvoParams(const std::string& path, const CvoParams& base = CvoParams());

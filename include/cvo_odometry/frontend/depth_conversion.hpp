@@ -12,3 +12,15 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
                       double max_depth);
 
 }  // namespace cvo
+
+namespace cvo {
+
+// Disparity image to 32-bit float metres (z = focal_times_baseline / d) with NaN where there is
+// no valid depth. `disparity_scale` turns stored values into pixels: 1 for CV_32F pixels (as
+// stereo_msgs/DisparityImage carries) and plain 8-bit images, 1/16 for OpenCV's CV_16S fixed
+// point, 1/256 for KITTI's 16-bit PNGs. Non-positive, NaN and inf disparities and depths outside
+// [min_depth, max_depth] become NaN; other types throw std::invalid_argument.
+cv::Mat disparityToMetres(const cv::Mat& disparity, double focal_times_baseline,
+                          double disparity_scale, double min_depth, double max_depth);
+
+}  // namespace cvo

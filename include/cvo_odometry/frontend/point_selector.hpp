@@ -1,6 +1,6 @@
 // Which pixels become cloud points. FAST corners (OpenCV, no non-max suppression) with a
 // threshold adapted frame to frame so that the count of selected pixels with valid depth lands
-// in [min_points, max_points]; or a uniform grid, for comparison.
+// in [min_points, max_points]; a uniform grid; or half of each (mixed).
 #pragma once
 
 #include <vector>
@@ -9,7 +9,8 @@
 
 namespace cvo {
 
-enum class SelectorKind { kFast, kGrid };
+// kMixed: half the points FAST corners, half a uniform grid.
+enum class SelectorKind { kFast, kGrid, kMixed };
 
 struct SelectorOptions {
   SelectorKind kind = SelectorKind::kFast;
@@ -38,7 +39,9 @@ class PointSelector {
 
  private:
   std::vector<cv::Point> fastPixels(const cv::Mat& grey, const cv::Mat& valid, int threshold) const;
-  std::vector<cv::Point> gridPixels(const cv::Mat& valid) const;
+  std::vector<cv::Point> gridPixels(const cv::Mat& valid, double target) const;
+  std::vector<cv::Point> adaptiveFastPixels(const cv::Mat& grey, const cv::Mat& valid,
+                                            std::size_t lo, std::size_t hi, int* used_threshold);
 
   SelectorOptions options_;
   int threshold_;  // carried to the next frame: consecutive frames need similar thresholds

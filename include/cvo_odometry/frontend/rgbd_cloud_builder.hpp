@@ -1,23 +1,15 @@
 // RGB-D images to a labeled cloud in the camera's optical frame (z forward, x right, y down).
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
 
-#include "cvo_odometry/core/labeled_cloud.hpp"
-#include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
-#include "cvo_odometry/frontend/point_selector.hpp"
+#include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 namespace cvo {
 
 struct RgbdFrontendOptions {
   double depth_units_per_metre = 1000.0;  // 16UC1 depth: 1000 (ROS, mm) or 5000 (TUM PNG)
-  double min_depth = 0.1;                 // metres
-  double max_depth = 10.0;
-  SelectorOptions selector;
-  int semantic_classes = 0;  // > 0: a segmentation image is expected
-  std::vector<int> ignore_classes;
+  CloudBuilderOptions cloud;
 };
 
 struct RgbdFrame {
@@ -26,16 +18,6 @@ struct RgbdFrame {
   PinholeIntrinsics intrinsics;
   cv::Mat semantics;  // optional: class ids or class probabilities
 };
-
-struct FrontendStats {
-  SelectionStats selection;
-  std::size_t valid_depth_pixels = 0;
-  double time_ms = 0.0;
-};
-
-// Rays (x/z, y/z) through pixel centres, undistorted when the intrinsics carry distortion.
-std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
-                                        const PinholeIntrinsics& intrinsics);
 
 class RgbdCloudBuilder {
  public:
@@ -49,7 +31,7 @@ class RgbdCloudBuilder {
 
  private:
   RgbdFrontendOptions options_;
-  PointSelector selector_;
+  DepthCloudBuilder cloud_builder_;
 };
 
 }  // namespace cvo

@@ -1,0 +1,56 @@
+// Image + metric depth (+ segmentation) to a labeled cloud in the camera's optical frame (z
+// forward, x right, y down). The RGB-D and stereo front ends both end here.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
+#include "cvo_odometry/frontend/point_selector.hpp"
+
+namespace cvo {
+
+struct CloudBuilderOptions {
+  double min_depth = 0.1;  // metres; applied by whoever turns raw depth or disparity into metres
+  double max_depth = 10.0;
+  int crop_top_rows = 0;  // rows at the top never selected (KITTI: sky and stereo-less band)
+  SelectorOptions selector;
+  int semantic_classes = 0;  // > 0: a segmentation image is expected
+  std::vector<int> ignore_classes;
+
+  // Throws std::invalid_argument naming the option that makes no sense.
+  void validate() const;
+};
+
+struct FrontendStats {
+  SelectionStats selection;
+  std::size_t valid_depth_pixels = 0;
+  double time_ms = 0.0;
+};
+
+// Rays (x/z, y/z) through pixel centres, undistorted when the intrinsics carry distortion.
+std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
+                                        const PinholeIntrinsics& intrinsics);
+
+class DepthCloudBuilder {
+ public:
+  explicit DepthCloudBuilder(const CloudBuilderOptions& options);
+
+  // `depth_metres`: CV_32FC1, NaN where invalid, registered to `image` (8-bit BGR or grey).
+  // Throws std::invalid_argument naming the problem: empty or mismatched images, intrinsics that
+  // make no sense or do not match the image, a missing or unusable segmentation image, or no
+  // pixel with valid depth.
+  LabeledCloud build(const cv::Mat& image, const cv::Mat& depth_metres,
+                     const PinholeIntrinsics& intrinsics, const cv::Mat& semantics,
+                     FrontendStats* stats);
+
+  const CloudBuilderOptions& options() const { return options_; }
+
+ private:
+  CloudBuilderOptions options_;
+  PointSelector selector_;
+};
+
+}  // namespace cvo

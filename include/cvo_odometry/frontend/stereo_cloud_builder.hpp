@@ -1,0 +1,49 @@
+// A rectified stereo pair (or a left image with a given disparity image) to a labeled cloud in
+// the left camera's optical frame.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "cvo_odometry/frontend/depth_cloud_builder.hpp"
+#include "cvo_odometry/frontend/stereo_matcher.hpp"
+
+namespace cvo {
+
+struct StereoFrontendOptions {
+  StereoMatcherOptions matcher;
+  double disparity_scale = 1.0;  // stored disparity value -> pixels (given disparity images)
+  CloudBuilderOptions cloud;     // stereo defaults: see kittiStereoFrontendOptions()
+};
+
+// KITTI-like defaults: top 100 rows cropped, 55 m maximum range, 3k..15k points.
+StereoFrontendOptions kittiStereoFrontendOptions();
+
+struct StereoFrame {
+  cv::Mat left;       // 8-bit BGR or grey, rectified
+  cv::Mat right;      // may be empty when `disparity` is given
+  cv::Mat disparity;  // optional: disparity of `left` (see disparity_scale); skips matching
+  PinholeIntrinsics intrinsics;  // of the rectified left image
+  double baseline = 0.0;         // metres, > 0
+  cv::Mat semantics;             // optional: class ids or class probabilities
+};
+
+class StereoCloudBuilder {
+ public:
+  explicit StereoCloudBuilder(const StereoFrontendOptions& options);
+
+  // Throws std::invalid_argument naming the problem (no right image and no disparity, sizes that
+  // differ, a baseline or intrinsics that make no sense, no valid depth, ...).
+  LabeledCloud build(const StereoFrame& frame, FrontendStats* stats = nullptr);
+
+  // Depth in metres (CV_32FC1, NaN invalid) of the frame, from its disparity or by matching.
+  cv::Mat depth(const StereoFrame& frame) const;
+
+  const StereoFrontendOptions& options() const { return options_; }
+
+ private:
+  StereoFrontendOptions options_;
+  StereoMatcher matcher_;
+  DepthCloudBuilder cloud_builder_;
+};
+
+}  // namespace cvo

@@ -1,0 +1,117 @@
+#include "cvo_odometry/frontend/depth_cloud_builder.hpp"
+
+#include <chrono>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/calib3d.hpp>
+
+#include "cvo_odometry/frontend/color_features.hpp"
+#include "cvo_odometry/frontend/semantic_image.hpp"
+
+namespace cvo {
+
+namespace {
+
+std::string sizeText(const cv::Mat& m) {
+  return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
+}  // namespace
+
+void CloudBuilderOptions::validate() const {
+  if (!(min_depth >= 0.0) || !(max_depth > min_depth)) {
+    throw std::invalid_argument("depth range [" + std::to_string(min_depth) + ", " +
+                                std::to_string(max_depth) + "] makes no sense");
+  }
+  if (crop_top_rows < 0) throw std::invalid_argument("crop_top_rows must be >= 0");
+  if (selector.min_points < 1 || selector.max_points < selector.min_points) {
+    throw std::invalid_argument("point count range [" + std::to_string(selector.min_points) + ", " +
+                                std::to_string(selector.max_points) + "] makes no sense");
+  }
+  if (semantic_classes < 0) throw std::invalid_argument("semantic_classes must be >= 0");
+}
+
+std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
+                                        const PinholeIntrinsics& K) {
+  std::vector<cv::Point2f> rays(pixels.size());
+  if (K.distortion.empty()) {
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      rays[k] = cv::Point2f(static_cast<float>((pixels[k].x - K.cx) / K.fx),
+                            static_cast<float>((pixels[k].y - K.cy) / K.fy));
+    }
+    return rays;
+  }
+  if (pixels.empty()) return rays;
+  std::vector<cv::Point2f> in(pixels.begin(), pixels.end());
+  const cv::Matx33d camera(K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+  cv::undistortPoints(in, rays, camera, K.distortion);
+  return rays;
+}
+
+DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
+    : options_(options), selector_(options.selector) {
+  options_.validate();
+}
+
+LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth,
+                                      const PinholeIntrinsics& intrinsics,
+                                      const cv::Mat& semantics_image, FrontendStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  if (image.empty()) throw std::invalid_argument("colour image is empty");
+  if (depth.empty()) throw std::invalid_argument("depth image is empty");
+  if (depth.type() != CV_32FC1) throw std::invalid_argument("metric depth must be 32FC1");
+  if (image.size() != depth.size()) {
+    throw std::invalid_argument("colour image is " + sizeText(image) + " but depth is " +
+                                sizeText(depth));
+  }
+  intrinsics.validate();
+  if (intrinsics.width != image.cols || intrinsics.height != image.rows) {
+    throw std::invalid_argument("camera info is for " + std::to_string(intrinsics.width) + "x" +
+                                std::to_string(intrinsics.height) + " images but the image is " +
+                                sizeText(image));
+  }
+  std::unique_ptr<SemanticImage> semantics;
+  if (options_.semantic_classes > 0) {
+    if (semantics_image.empty()) throw std::invalid_argument("segmentation image missing");
+    if (semantics_image.size() != image.size()) {
+      throw std::invalid_argument("segmentation is " + sizeText(semantics_image) +
+                                  " but the image is " + sizeText(image));
+    }
+    semantics = std::make_unique<SemanticImage>(semantics_image, options_.semantic_classes,
+                                                options_.ignore_classes);
+  }
+  cv::Mat valid = (depth == depth);  // false for NaN
+  valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
+  const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
+  if (valid_count == 0) throw std::invalid_argument("no pixel has valid depth");
+  const cv::Mat grey = toGrey(image);
+  const cv::Mat features = colorFeatures(image);
+  FrontendStats local;
+  const auto pixels = selector_.select(grey, valid, &local.selection);
+
+  const auto rays = normalisedRays(pixels, intrinsics);
+  LabeledCloud cloud(true, options_.semantic_classes);
+  cloud.reserve(pixels.size());
+  std::vector<float> probabilities(
+      static_cast<std::size_t>(std::max(options_.semantic_classes, 1)));
+  for (std::size_t k = 0; k < pixels.size(); ++k) {
+    const cv::Point& p = pixels[k];
+    if (semantics && !semantics->probabilities(p.x, p.y, probabilities.data())) continue;
+    const float z = depth.at<float>(p);
+    const Eigen::Vector3f position(rays[k].x * z, rays[k].y * z, z);
+    cloud.add(position, features.ptr<float>(p.y) + 5 * p.x,
+              semantics ? probabilities.data() : nullptr);
+  }
+  if (cloud.size() == 0) {
+    throw std::invalid_argument("every selected pixel belongs to an ignored class");
+  }
+  local.valid_depth_pixels = valid_count;
+  local.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (stats) *stats = local;
+  return cloud;
+}
+
+}  // namespace cvo

@@ -1,0 +1,62 @@
+#include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "cvo_odometry/frontend/depth_conversion.hpp"
+
+namespace cvo {
+
+StereoFrontendOptions kittiStereoFrontendOptions() {
+  StereoFrontendOptions options;
+  options.cloud.min_depth = 1.0;
+  options.cloud.max_depth = 55.0;
+  options.cloud.crop_top_rows = 100;
+  return options;
+}
+
+StereoCloudBuilder::StereoCloudBuilder(const StereoFrontendOptions& options)
+    : options_(options), matcher_(options.matcher), cloud_builder_(options.cloud) {
+  if (!(options.disparity_scale > 0.0)) {
+    throw std::invalid_argument("disparity scale must be positive");
+  }
+}
+
+cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
+  if (!(frame.baseline > 0.0) || !std::isfinite(frame.baseline)) {
+    throw std::invalid_argument("stereo baseline must be positive, got " +
+                                std::to_string(frame.baseline) + " m");
+  }
+  frame.intrinsics.validate();
+  cv::Mat disparity;
+  double scale = options_.disparity_scale;
+  if (!frame.disparity.empty()) {
+    if (frame.disparity.size() != frame.left.size()) {
+      throw std::invalid_argument("disparity image size differs from the left image's");
+    }
+    disparity = frame.disparity;
+  } else {
+    if (frame.right.empty()) {
+      throw std::invalid_argument("stereo frame has neither a right image nor a disparity image");
+    }
+    disparity = matcher_.disparity(frame.left, frame.right);
+    scale = 1.0;  // the matcher returns pixels
+  }
+  return disparityToMetres(disparity, frame.intrinsics.fx * frame.baseline, scale,
+                           options_.cloud.min_depth, options_.cloud.max_depth);
+}
+
+LabeledCloud StereoCloudBuilder::build(const StereoFrame& frame, FrontendStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  if (frame.left.empty()) throw std::invalid_argument("left image is empty");
+  LabeledCloud cloud =
+      cloud_builder_.build(frame.left, depth(frame), frame.intrinsics, frame.semantics, stats);
+  if (stats) {
+    stats->time_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  return cloud;
+}
+
+}  // namespace cvo

@@ -1,0 +1,204 @@
+// The RGB-D front end on real TUM fr1_xyz frames: depth encodings, invalid depth, point
+// selection and the errors bad input gets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+
+namespace {
+
+const std::string kTum = std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz";
+
+struct TumFrame {
+  cv::Mat image, depth;  // depth: TUM 16-bit PNG, 5000 per metre
+};
+
+TumFrame loadFrame(std::size_t index) {
+  const cvo::TumSequence sequence(kTum);
+  TumFrame f;
+  sequence.load(index, &f.image, &f.depth);
+  return f;
+}
+
+cvo::RgbdFrontendOptions options(cvo::SelectorKind kind, double units_per_metre) {
+  cvo::RgbdFrontendOptions o;
+  o.depth_units_per_metre = units_per_metre;
+  o.cloud.selector.kind = kind;
+  return o;
+}
+
+// Pixel of a cloud point (pinhole, no distortion).
+cv::Point2d project(const Eigen::Vector3f& p, const cvo::PinholeIntrinsics& K) {
+  return {K.fx * p.x() / p.z() + K.cx, K.fy * p.y() / p.z() + K.cy};
+}
+
+cvo::PinholeIntrinsics pinholeFr1() {
+  cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  K.distortion.clear();
+  return K;
+}
+
+TEST(TumSequence, ReadsTheFixtureWithDepthStampsBeforeRgb) {
+  const cvo::TumSequence sequence(kTum);
+  ASSERT_EQ(sequence.frames().size(), 37u);
+  for (const auto& f : sequence.frames()) {
+    EXPECT_GT(f.rgb_stamp - f.depth_stamp, 0.010);
+    EXPECT_LT(f.rgb_stamp - f.depth_stamp, 0.021);
+  }
+  cv::Mat image, depth;
+  sequence.load(0, &image, &depth);
+  EXPECT_EQ(image.type(), CV_8UC3);
+  EXPECT_EQ(depth.type(), CV_16UC1);
+}
+
+TEST(RgbdFrontend, FastSelectionLandsInTheConfiguredRangeWithValidDepth) {
+  const TumFrame f = loadFrame(10);
+  cvo::RgbdCloudBuilder builder(options(cvo::SelectorKind::kFast, 5000.0));
+  cvo::FrontendStats stats;
+  const cvo::LabeledCloud cloud =
+      builder.build({f.image, f.depth, pinholeFr1(), cv::Mat()}, &stats);
+  EXPECT_GE(cloud.size(), 3000u);
+  EXPECT_LE(cloud.size(), 15000u);
+  EXPECT_EQ(cloud.size(), stats.selection.selected);
+  EXPECT_GT(stats.selection.fast_threshold, 0);
+  EXPECT_GT(stats.valid_depth_pixels, 200000u);  // most of a 640x480 Kinect frame
+  EXPECT_GT(stats.time_ms, 0.0);
+  EXPECT_EQ(cloud.firstNonFinite(), -1);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_GE(cloud.position(i).z(), 0.1f);
+    ASSERT_LE(cloud.position(i).z(), 10.0f);
+    for (int c = 0; c < 3; ++c) {  // B, G, R in [0, 1]
+      ASSERT_GE(cloud.color(i)[c], 0.0f);
+      ASSERT_LE(cloud.color(i)[c], 1.0f);
+    }
+  }
+  // The fr1_xyz desk scene is 0.5-3 m away.
+  double mean_z = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    mean_z += cloud.position(i).z();
+  mean_z /= cloud.size();
+  EXPECT_GT(mean_z, 0.6);
+  EXPECT_LT(mean_z, 2.5);
+}
+
+TEST(RgbdFrontend, FastThresholdAdaptsToTheRange) {
+  const TumFrame f = loadFrame(10);
+  for (auto [lo, hi] : {std::pair{1000, 2000}, std::pair{8000, 12000}}) {
+    cvo::RgbdFrontendOptions o = options(cvo::SelectorKind::kFast, 5000.0);
+    o.cloud.selector.min_points = lo;
+    o.cloud.selector.max_points = hi;
+    cvo::RgbdCloudBuilder builder(o);
+    cvo::FrontendStats stats;
+    const auto cloud = builder.build({f.image, f.depth, pinholeFr1(), cv::Mat()}, &stats);
+    EXPECT_GE(cloud.size(), static_cast<std::size_t>(lo)) << lo << ".." << hi;
+    EXPECT_LE(cloud.size(), static_cast<std::size_t>(hi)) << lo << ".." << hi;
+  }
+}
+
+TEST(RgbdFrontend, DepthEncodingsGiveTheSameCloud) {
+  const TumFrame f = loadFrame(5);
+  const cvo::PinholeIntrinsics K = pinholeFr1();
+  // TUM PNG (5000/m), ROS 16UC1 millimetres and 32FC1 metres of the same depth.
+  cv::Mat metres, millimetres;
+  f.depth.convertTo(metres, CV_32F, 1.0 / 5000.0);
+  f.depth.convertTo(millimetres, CV_16U, 1000.0 / 5000.0);
+  cvo::RgbdCloudBuilder tum(options(cvo::SelectorKind::kGrid, 5000.0));
+  cvo::RgbdCloudBuilder ros_mm(options(cvo::SelectorKind::kGrid, 1000.0));
+  cvo::RgbdCloudBuilder ros_float(options(cvo::SelectorKind::kGrid, 1000.0));
+  const auto a = tum.build({f.image, f.depth, K, cv::Mat()});
+  const auto b = ros_mm.build({f.image, millimetres, K, cv::Mat()});
+  const auto c = ros_float.build({f.image, metres, K, cv::Mat()});
+  ASSERT_EQ(a.size(), c.size());
+  ASSERT_NEAR(static_cast<double>(a.size()), static_cast<double>(b.size()), 0.001 * a.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    ASSERT_LT((a.position(i) - c.position(i)).norm(), 1e-5f);
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); i += 97)
+    EXPECT_LT((a.position(i) - b.position(i)).norm(), 0.002f);  // millimetre rounding
+}
+
+TEST(RgbdFrontend, InvalidDepthIsSkipped) {
+  const TumFrame f = loadFrame(5);
+  const cvo::PinholeIntrinsics K = pinholeFr1();
+  cv::Mat depth;
+  f.depth.convertTo(depth, CV_32F, 1.0 / 5000.0);
+  // Four bands of bad depth: zero, NaN, inf and beyond max_depth.
+  const float bad[] = {0.0f, std::numeric_limits<float>::quiet_NaN(),
+                       std::numeric_limits<float>::infinity(), 25.0f};
+  for (int band = 0; band < 4; ++band)
+    depth.colRange(band * 80, band * 80 + 80).setTo(bad[band]);
+  cvo::RgbdCloudBuilder builder(options(cvo::SelectorKind::kGrid, 1000.0));
+  cvo::FrontendStats stats;
+  const auto cloud = builder.build({f.image, depth, K, cv::Mat()}, &stats);
+  ASSERT_GT(cloud.size(), 1000u);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    ASSERT_GE(project(cloud.position(i), K).x, 319.5) << "point from a band of invalid depth";
+  EXPECT_EQ(cloud.firstNonFinite(), -1);
+}
+
+TEST(RgbdFrontend, DistortionModelMovesRaysOffCentre) {
+  const std::vector<cv::Point> pixels{{318, 255}, {20, 20}};
+  const auto distorted = cvo::normalisedRays(pixels, cvo::tumIntrinsics("fr1"));
+  const auto pinhole = cvo::normalisedRays(pixels, pinholeFr1());
+  EXPECT_NEAR(distorted[0].x, pinhole[0].x, 1e-3);  // near the centre: the same ray
+  EXPECT_GT(std::abs(distorted[1].x - pinhole[1].x), 0.01);
+}
+
+void expectError(const std::function<void()>& call, const std::string& words) {
+  try {
+    call();
+    FAIL() << "no error; expected one mentioning '" << words << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+  }
+}
+
+TEST(RgbdFrontend, BadInputGetsAClearError) {
+  const TumFrame f = loadFrame(0);
+  const cvo::PinholeIntrinsics K = pinholeFr1();
+  cvo::RgbdCloudBuilder builder(options(cvo::SelectorKind::kFast, 5000.0));
+  expectError([&] { builder.build({cv::Mat(), f.depth, K, cv::Mat()}); }, "colour image is empty");
+  expectError([&] { builder.build({f.image, cv::Mat(), K, cv::Mat()}); }, "depth image is empty");
+  cv::Mat half;
+  cv::resize(f.depth, half, cv::Size(320, 240), 0, 0, cv::INTER_NEAREST);
+  expectError(
+      [&] {
+        builder.build({f.image, half, K, cv::Mat()});
+      },
+      "640x480 but depth is 320x240");
+  cv::Mat bytes;
+  f.depth.convertTo(bytes, CV_8U);
+  expectError(
+      [&] {
+        builder.build({f.image, bytes, K, cv::Mat()});
+      },
+      "unsupported depth image type");
+  expectError(
+      [&] {
+        builder.build({f.image, cv::Mat::zeros(480, 640, CV_16UC1), K, cv::Mat()});
+      },
+      "no pixel has valid depth");
+  cvo::PinholeIntrinsics nan_focal = K;
+  nan_focal.fx = std::numeric_limits<double>::quiet_NaN();
+  expectError([&] { builder.build({f.image, f.depth, nan_focal, cv::Mat()}); }, "focal");
+  cvo::PinholeIntrinsics other_size = K;
+  other_size.width = 1280;
+  expectError(
+      [&] {
+        builder.build({f.image, f.depth, other_size, cv::Mat()});
+      },
+      "camera info is for 1280x480");
+  cvo::RgbdFrontendOptions inverted = options(cvo::SelectorKind::kFast, 5000.0);
+  inverted.cloud.min_depth = 5.0;
+  inverted.cloud.max_depth = 1.0;
+  expectError([&] { cvo::RgbdCloudBuilder{inverted}; }, "depth range");
+}
+
+}  // namespace

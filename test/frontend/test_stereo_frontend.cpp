@@ -1,0 +1,214 @@
+// The stereo front end on real KITTI data: our SGBM disparity against a third party's on the
+// same pair, the given-disparity path, cropping and range, the KITTI sequence reader, and one
+// stereo registration against the official ground truth.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/params_io.hpp"
+#include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/frontend_params.hpp"
+#include "cvo_odometry/frontend/kitti_sequence.hpp"
+#include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+
+namespace {
+
+const std::string kData = CVO_TEST_DATA_DIR;
+const std::string kPair = kData + "/kitti_stereo_pair";
+const std::string kKitti = kData + "/kitti_06_stereo";
+
+// Calibration published with the pair (KITTI odometry 00-02 geometry).
+cvo::PinholeIntrinsics pairIntrinsics() {
+  cvo::PinholeIntrinsics K;
+  K.fx = K.fy = 718.856;
+  K.cx = 607.1928;
+  K.cy = 185.2157;
+  K.width = 1241;
+  K.height = 376;
+  return K;
+}
+constexpr double kPairBaseline = 0.537;
+
+cv::Mat readGrey(const std::string& path) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) throw std::runtime_error("missing " + path);
+  return image;
+}
+
+// KITTI's stereo benchmark rule: a pixel agrees when its error is at most 3 px or 5 %.
+TEST(StereoMatcher, AgreesWithThirdPartyDisparityOnTheKittiPair) {
+  const cv::Mat left = readGrey(kPair + "/left.png"), right = readGrey(kPair + "/right.png");
+  const cv::Mat theirs = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(theirs.type(), CV_8UC1);
+  const cvo::StereoMatcher matcher{cvo::StereoMatcherOptions()};
+  const cv::Mat ours = matcher.disparity(left, right);
+  ASSERT_EQ(ours.type(), CV_32FC1);
+  std::size_t compared = 0, agreeing = 0, ours_valid = 0;
+  std::vector<float> errors;
+  for (int v = 100; v < ours.rows; ++v) {    // below the band without stereo overlap
+    for (int u = 128; u < ours.cols; ++u) {  // left of num_disparities nothing can match
+      const float d = ours.at<float>(v, u);
+      if (!std::isfinite(d)) continue;
+      ++ours_valid;
+      const float t = theirs.at<std::uint8_t>(v, u);
+      if (t <= 0) continue;
+      ++compared;
+      const float error = std::abs(d - t);
+      errors.push_back(error);
+      if (error <= 3.0f || error <= 0.05f * t) ++agreeing;
+    }
+  }
+  const std::size_t area = static_cast<std::size_t>((ours.rows - 100) * (ours.cols - 128));
+  EXPECT_GT(ours_valid, area / 2) << "SGBM left most pixels without a disparity";
+  ASSERT_GT(compared, area / 2);
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  const double median = errors[errors.size() / 2];
+  const double fraction = static_cast<double>(agreeing) / compared;
+  std::cout << "disparity vs third party: " << compared << " pixels, median |error| " << median
+            << " px, " << 100.0 * fraction << " % within 3 px or 5 %\n";
+  EXPECT_LT(median, 1.0);
+  EXPECT_GT(fraction, 0.90);
+}
+
+TEST(StereoFrontend, GivenDisparityGivesMetricDepthCroppedAndInRange) {
+  const cv::Mat left = readGrey(kPair + "/left.png");
+  const cv::Mat disparity = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
+  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoFrame frame;
+  frame.left = left;
+  frame.disparity = disparity;
+  frame.intrinsics = pairIntrinsics();
+  frame.baseline = kPairBaseline;
+  cvo::FrontendStats stats;
+  const auto cloud = builder.build(frame, &stats);
+  EXPECT_GE(cloud.size(), 3000u);
+  EXPECT_LE(cloud.size(), 15000u);
+  const auto K = pairIntrinsics();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto p = cloud.position(i);
+    ASSERT_GE(p.z(), 1.0f);
+    ASSERT_LE(p.z(), 55.0f);
+    ASSERT_GE(K.fy * p.y() / p.z() + K.cy, 99.5) << "a point from the cropped top rows";
+    // z = f b / d exactly for the pixel the point came from.
+    const int u = static_cast<int>(std::lround(K.fx * p.x() / p.z() + K.cx));
+    const int v = static_cast<int>(std::lround(K.fy * p.y() / p.z() + K.cy));
+    ASSERT_NEAR(p.z(), K.fx * kPairBaseline / disparity.at<std::uint8_t>(v, u), 1e-3 * p.z());
+  }
+}
+
+TEST(StereoFrontend, MatchedAndGivenDisparityGiveSimilarDepth) {
+  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoFrame matched;
+  matched.left = readGrey(kPair + "/left.png");
+  matched.right = readGrey(kPair + "/right.png");
+  matched.intrinsics = pairIntrinsics();
+  matched.baseline = kPairBaseline;
+  cvo::StereoFrame given = matched;
+  given.right = cv::Mat();
+  given.disparity = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
+  const cv::Mat a = builder.depth(matched), b = builder.depth(given);
+  std::vector<float> relative;
+  for (int v = 100; v < a.rows; ++v)
+    for (int u = 128; u < a.cols; ++u)
+      if (std::isfinite(a.at<float>(v, u)) && std::isfinite(b.at<float>(v, u)))
+        relative.push_back(std::abs(a.at<float>(v, u) - b.at<float>(v, u)) / b.at<float>(v, u));
+  ASSERT_GT(relative.size(), 100000u);
+  std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
+  EXPECT_LT(relative[relative.size() / 2], 0.05) << "median relative depth difference";
+}
+
+TEST(DisparityConversion, EncodingsAndInvalidValues) {
+  cv::Mat fixed_point = (cv::Mat_<std::int16_t>(1, 4) << 160, -16, 0, 320);  // OpenCV 16S
+  const cv::Mat z = cvo::disparityToMetres(fixed_point, 100.0, 1.0 / 16.0, 0.5, 60.0);
+  EXPECT_FLOAT_EQ(z.at<float>(0, 0), 10.0f);
+  EXPECT_TRUE(std::isnan(z.at<float>(0, 1)));
+  EXPECT_TRUE(std::isnan(z.at<float>(0, 2)));
+  EXPECT_FLOAT_EQ(z.at<float>(0, 3), 5.0f);
+  cv::Mat kitti16 = (cv::Mat_<std::uint16_t>(1, 2) << 2560, 256);  // KITTI: value / 256
+  const cv::Mat z16 = cvo::disparityToMetres(kitti16, 100.0, 1.0 / 256.0, 0.5, 60.0);
+  EXPECT_FLOAT_EQ(z16.at<float>(0, 0), 10.0f);
+  EXPECT_TRUE(std::isnan(z16.at<float>(0, 1))) << "100 m is beyond max_depth";
+  EXPECT_THROW(cvo::disparityToMetres(cv::Mat::zeros(2, 2, CV_64F), 1.0, 1.0, 0.1, 10.0),
+               std::invalid_argument);
+  EXPECT_THROW(cvo::disparityToMetres(kitti16, 0.0, 1.0, 0.1, 10.0), std::invalid_argument);
+}
+
+TEST(StereoFrontend, BadInputGetsAClearError) {
+  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoFrame frame;
+  frame.left = readGrey(kPair + "/left.png");
+  frame.intrinsics = pairIntrinsics();
+  frame.baseline = kPairBaseline;
+  auto message = [&](const cvo::StereoFrame& f) {
+    try {
+      builder.build(f);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(frame).find("neither a right image nor a disparity"), std::string::npos);
+  cvo::StereoFrame small = frame;
+  cv::resize(frame.left, small.right, cv::Size(620, 188));
+  EXPECT_NE(message(small).find("but right is 620x188"), std::string::npos) << message(small);
+  cvo::StereoFrame no_baseline = frame;
+  no_baseline.right = frame.left;
+  no_baseline.baseline = 0.0;
+  EXPECT_NE(message(no_baseline).find("baseline must be positive"), std::string::npos);
+  cvo::StereoMatcherOptions odd;
+  odd.num_disparities = 100;
+  EXPECT_THROW(cvo::StereoMatcher{odd}, std::invalid_argument);
+}
+
+TEST(KittiSequence, ReadsCalibrationTimesAndImages) {
+  const cvo::KittiSequence sequence(kKitti);
+  ASSERT_EQ(sequence.size(), 8u);
+  EXPECT_NEAR(sequence.calibration().left.fx, 707.0912, 1e-6);
+  EXPECT_NEAR(sequence.calibration().baseline, 0.5372, 1e-4);
+  EXPECT_EQ(sequence.calibration().left.width, 1226);
+  EXPECT_EQ(sequence.calibration().left.height, 370);
+  EXPECT_NEAR(sequence.stamps()[1] - sequence.stamps()[0], 0.1, 0.01);
+  cv::Mat left, right, segmentation;
+  sequence.load(3, &left, &right, &segmentation);
+  EXPECT_EQ(left.size(), right.size());
+  EXPECT_TRUE(segmentation.empty());
+  EXPECT_THROW(cvo::KittiSequence(kKitti, 1), std::invalid_argument);
+  EXPECT_THROW(cvo::KittiSequence(kData + "/tum_fr1_xyz"), std::runtime_error);
+}
+
+// One real stereo registration (frame 0 -> 1, about 1 m forward) against the official poses.
+TEST(StereoFrontend, StereoCloudsRegisterToGroundTruth) {
+  const cvo::KittiSequence sequence(kKitti);
+  cvo::StereoFrontendOptions options = cvo::kittiStereoFrontendOptions();
+  cvo::loadFrontendParams(std::string(CVO_SOURCE_DIR) + "/config/kitti_stereo.yaml",
+                          &options.cloud);
+  cvo::StereoCloudBuilder builder(options);
+  auto cloud = [&](std::size_t k) {
+    cvo::StereoFrame f;
+    sequence.load(k, &f.left, &f.right, nullptr);
+    f.intrinsics = sequence.calibration().left;
+    f.baseline = sequence.calibration().baseline;
+    return builder.build(f);
+  };
+  const auto target = cloud(0), source = cloud(1);
+  const auto gt = cvo::readKittiTrajectory(kKitti + "/poses.txt");
+  const Eigen::Isometry3d truth = gt[0].pose.inverse() * gt[1].pose;
+  ASSERT_GT(truth.translation().norm(), 0.5);
+  cvo::CvoParams params =
+      cvo::loadCvoParams(std::string(CVO_SOURCE_DIR) + "/config/kitti_stereo.yaml");
+  params.backend = cvo::BackendChoice::kCpu;
+  cvo::CvoRegistration registration(params);
+  const auto result = registration.align(target, source, Eigen::Isometry3d::Identity(), true);
+  ASSERT_TRUE(result.report.converged) << result.report.message;
+  const Eigen::Isometry3d error = truth.inverse() * result.transform;
+  EXPECT_LT(error.translation().norm(), 0.05);
+  EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI, 0.2);
+}
+
+}  // namespace
