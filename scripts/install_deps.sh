@@ -14,7 +14,8 @@ full=("${core[@]}" libopencv-dev clang-format
   rospack-tools librosbag-dev python3-rosbag python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
   ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-stereo-msgs libstereo-msgs-dev
   libcv-bridge-dev libimage-transport-dev libdiagnostic-updater-dev libdiagnostic-msgs-dev
-  ros-diagnostic-msgs libstereo-image-proc-dev ros-stereo-image-proc python3-matplotlib)
+  ros-diagnostic-msgs libstereo-image-proc-dev ros-stereo-image-proc python3-matplotlib
+  libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev rviz)
 # Peers for bench/peer_table.sh only (large: PCL, Open3D, OpenCV contrib).
 peers=(libopencv-contrib-dev libpcl-dev python3-open3d python3-numpy)
 

@@ -1,0 +1,35 @@
+#include "cvo_odometry/core/registration_covariance.hpp"
+
+#include <algorithm>
+
+#include <Eigen/Cholesky>
+
+namespace cvo {
+
+Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
+                                                   const Eigen::Isometry3d& T, double lengthscale,
+                                                   double cosine) {
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  const Matrix6d unknown = Matrix6d::Identity() * 1e6;
+  if (source.size() < 3 || !(lengthscale > 0.0)) return unknown;
+  // J = d(T p)/d(t, w) for a left perturbation: [I, -[Tp]x].
+  Matrix6d information = Matrix6d::Zero();
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    const Eigen::Vector3d p = T * source.position(i).cast<double>();
+    Eigen::Matrix<double, 3, 6> J;
+    J.leftCols<3>().setIdentity();
+    J.rightCols<3>() << 0, p.z(), -p.y(), -p.z(), 0, p.x(), p.y(), -p.x(), 0;
+    information.noalias() += J.transpose() * J;
+  }
+  information /= lengthscale * lengthscale;
+  const Eigen::LDLT<Matrix6d> ldlt(information);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+      ldlt.vectorD().minCoeff() <= 1e-12 * ldlt.vectorD().maxCoeff()) {
+    return unknown;
+  }
+  Matrix6d covariance = ldlt.solve(Matrix6d::Identity());
+  covariance = 0.5 * (covariance + covariance.transpose());
+  return covariance / std::clamp(cosine, 1e-3, 1.0);
+}
+
+}  // namespace cvo

@@ -1,0 +1,115 @@
+// cvo_make_bag: a TUM RGB-D or KITTI odometry folder as a rosbag with the nodelet's topics, so the
+// public datasets replay like a live camera.
+//   TUM:   <ns>/rgb/image_rect_color (bgr8, rgb time), <ns>/rgb/camera_info,
+//          <ns>/depth_registered/image_rect (32FC1 metres, depth time)
+//   KITTI: <ns>/left/image_rect, <ns>/right/image_rect (mono8), <ns>/left|right/camera_info;
+//          stamps are times.txt + 1 s (ROS time 0 means "no stamp")
+#include <iostream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/image_encodings.h>
+#include <opencv2/imgproc.hpp>
+
+#include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/kitti_sequence.hpp"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+#include "cvo_odometry/tools/command_line.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: cvo_make_bag (--tum DIR [--camera fr1|fr2|fr3|fx,fy,cx,cy] | --kitti DIR) --out BAG\n"
+    "  --ns NAME          topic namespace (/camera for TUM, /stereo for KITTI)\n"
+    "  --frame-id NAME    camera frame (camera_rgb_optical_frame / camera_left)\n"
+    "  --first N --last N frame range\n";
+
+sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
+                                   const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = static_cast<uint32_t>(K.width);
+  info.height = static_cast<uint32_t>(K.height);
+  info.distortion_model = "plumb_bob";
+  info.D = K.distortion.empty() ? std::vector<double>(5, 0.0) : K.distortion;
+  info.K = {K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {K.fx, 0, K.cx, tx, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+sensor_msgs::ImagePtr imageMsg(const cv::Mat& image, const std::string& encoding,
+                               const std_msgs::Header& header) {
+  return cv_bridge::CvImage(header, encoding, image).toImageMsg();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const cvo::CommandLine cli(
+        argc, argv, {"tum", "kitti", "camera", "out", "ns", "frame-id", "first", "last"}, {"help"});
+    if (cli.has("help") || (!cli.has("tum") && !cli.has("kitti"))) {
+      std::cout << kUsage;
+      return cli.has("help") ? 0 : 2;
+    }
+    rosbag::Bag bag(cli.require("out"), rosbag::bagmode::Write);
+    const int first = cli.getInt("first", 0);
+    std::size_t written = 0;
+    if (cli.has("tum")) {
+      const cvo::TumSequence sequence(cli.get("tum"));
+      const std::string ns = cli.get("ns", "/camera");
+      const cvo::PinholeIntrinsics K = cvo::tumIntrinsics(cli.get("camera", "fr1"));
+      const int last = cli.getInt("last", static_cast<int>(sequence.frames().size()) - 1);
+      std_msgs::Header header;
+      header.frame_id = cli.get("frame-id", "camera_rgb_optical_frame");
+      for (int k = first; k <= last; ++k) {
+        cv::Mat image, depth;
+        sequence.load(static_cast<std::size_t>(k), &image, &depth);
+        const auto& f = sequence.frames()[static_cast<std::size_t>(k)];
+        header.seq = static_cast<uint32_t>(k);
+        header.stamp = ros::Time(f.rgb_stamp);
+        bag.write(ns + "/rgb/image_rect_color", header.stamp,
+                  imageMsg(image, sensor_msgs::image_encodings::BGR8, header));
+        bag.write(ns + "/rgb/camera_info", header.stamp, cameraInfo(K, 0.0, header));
+        header.stamp = ros::Time(f.depth_stamp);
+        const cv::Mat metres = cvo::depthToMetres(depth, 5000.0, 0.0, 1e9);
+        bag.write(ns + "/depth_registered/image_rect", header.stamp,
+                  imageMsg(metres, sensor_msgs::image_encodings::TYPE_32FC1, header));
+        ++written;
+      }
+    } else {
+      const cvo::KittiSequence sequence(cli.get("kitti"));
+      const std::string ns = cli.get("ns", "/stereo");
+      const auto& calibration = sequence.calibration();
+      const int last = cli.getInt("last", static_cast<int>(sequence.size()) - 1);
+      std_msgs::Header header;
+      header.frame_id = cli.get("frame-id", "camera_left");
+      for (int k = first; k <= last; ++k) {
+        cv::Mat left, right;
+        sequence.load(static_cast<std::size_t>(k), &left, &right, nullptr);
+        cv::cvtColor(left, left, cv::COLOR_BGR2GRAY);
+        cv::cvtColor(right, right, cv::COLOR_BGR2GRAY);
+        header.seq = static_cast<uint32_t>(k);
+        header.stamp = ros::Time(sequence.stamps()[static_cast<std::size_t>(k)] + 1.0);
+        const double tx = -calibration.left.fx * calibration.baseline;
+        bag.write(ns + "/left/image_rect", header.stamp,
+                  imageMsg(left, sensor_msgs::image_encodings::MONO8, header));
+        bag.write(ns + "/left/camera_info", header.stamp,
+                  cameraInfo(calibration.left, 0.0, header));
+        bag.write(ns + "/right/image_rect", header.stamp,
+                  imageMsg(right, sensor_msgs::image_encodings::MONO8, header));
+        bag.write(ns + "/right/camera_info", header.stamp,
+                  cameraInfo(calibration.left, tx, header));
+        ++written;
+      }
+    }
+    bag.close();
+    std::cout << "cvo_make_bag: " << written << " frames -> " << cli.get("out") << "\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "cvo_make_bag: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,586 @@
+#include "cvo_odometry/ros/cvo_odometry_ros.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/image_encodings.h>
+#include <boost/function.hpp>
+
+#include "cvo_odometry/CvoIndicator.h"
+#include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/params_io.hpp"
+#include "cvo_odometry/core/registration_covariance.hpp"
+#include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/frontend_params.hpp"
+#include "cvo_odometry/ros/ros_conversions.hpp"
+
+namespace cvo {
+
+namespace {
+
+namespace sp = message_filters::sync_policies;
+
+// A synchronizer of `filters` with the exact or approximate policy, calling `object->*method`.
+// `frame_interval` > 0 tells the approximate policy that messages on one topic are at least that
+// far apart, so it can pair an image with the right depth when their stamps differ by up to half
+// a frame (TUM's depth is 12-20 ms older than its colour at 30 Hz).
+template <class... M, class T>
+std::shared_ptr<void> synchronize(bool approximate, int queue, double frame_interval,
+                                  void (T::*method)(const boost::shared_ptr<const M>&...),
+                                  T* object, message_filters::SimpleFilter<M>&... filters) {
+  if (approximate) {
+    using Sync = message_filters::Synchronizer<sp::ApproximateTime<M...>>;
+    auto sync = std::make_shared<Sync>(sp::ApproximateTime<M...>(queue), filters...);
+    if (frame_interval > 0.0) sync->setInterMessageLowerBound(ros::Duration(frame_interval));
+    sync->registerCallback(method, object);
+    return sync;
+  }
+  using Sync = message_filters::Synchronizer<sp::ExactTime<M...>>;
+  auto sync = std::make_shared<Sync>(sp::ExactTime<M...>(queue), filters...);
+  sync->registerCallback(method, object);
+  return sync;
+}
+
+// Every parameter, from the preset file first and then single ROS parameters of the same name.
+template <class T>
+void override(const ros::NodeHandle& pnh, const std::string& key, T* value) {
+  pnh.param(key, *value, *value);
+}
+
+std::string describe(const CvoParams& params, const CloudBuilderOptions& cloud) {
+  std::ostringstream out;
+  writeCvoParams(out, params);
+  out << "point_selector: "
+      << (cloud.selector.kind == SelectorKind::kFast   ? "fast"
+          : cloud.selector.kind == SelectorKind::kGrid ? "grid"
+                                                       : "mixed")
+      << "\nmin_points: " << cloud.selector.min_points
+      << "\nmax_points: " << cloud.selector.max_points << "\nmin_depth: " << cloud.min_depth
+      << "\nmax_depth: " << cloud.max_depth << "\ncrop_top_rows: " << cloud.crop_top_rows << "\n";
+  return out.str();
+}
+
+}  // namespace
+
+CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), it_(nh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
+  loadParameters();
+  odometry_ = std::make_unique<FrameToFrameOdometry>(params_);
+  ROS_INFO_STREAM("cvo_odometry: mode "
+                  << (mode_ == Mode::kRgbd     ? "rgbd"
+                      : mode_ == Mode::kStereo ? "stereo"
+                                               : "disparity")
+                  << ", backend " << odometry_->registration().backend().name() << ", frames "
+                  << odom_frame_ << " -> " << base_frame_ << "; effective parameters:\n"
+                  << describe(params_, cloud_options_));
+
+  odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", 10);
+  indicator_pub_ = nh_.advertise<cvo_odometry::CvoIndicator>("indicator", 10);
+  path_pub_ = nh_.advertise<nav_msgs::Path>("path", 1, true);
+  current_cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("cloud/current", 1);
+  previous_cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("cloud/previous", 1);
+  aligned_cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("cloud/aligned", 1);
+  reset_service_ = pnh_.advertiseService("reset", &CvoOdometryRos::onReset, this);
+
+  diagnostics_.setHardwareID("cvo_odometry");
+  diagnostics_.add("odometry", this, &CvoOdometryRos::diagnose);
+  rate_diagnostic_ = std::make_unique<diagnostic_updater::HeaderlessTopicDiagnostic>(
+      "odom", diagnostics_, diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_));
+  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0),
+                                       [this](const ros::TimerEvent&) { diagnostics_.update(); });
+
+  reconfigure_ =
+      std::make_unique<dynamic_reconfigure::Server<CvoOdometryConfig>>(reconfigure_mutex_, pnh_);
+  CvoOdometryConfig initial;
+  initial.ell_init = params_.ell_init, initial.ell_min = params_.ell_min;
+  initial.ell_first_frame = params_.ell_first_frame,
+  initial.schedule_decay = params_.schedule_decay;
+  initial.sigma = params_.sigma, initial.sp_thres = params_.sp_thres;
+  initial.use_color = params_.use_color, initial.color_ell = params_.color_ell;
+  initial.color_sigma = params_.color_sigma, initial.use_semantics = params_.use_semantics;
+  initial.semantic_ell = params_.semantic_ell, initial.semantic_sigma = params_.semantic_sigma;
+  initial.max_iterations = params_.max_iterations, initial.min_step = params_.min_step;
+  initial.max_step = params_.max_step, initial.min_points = cloud_options_.selector.min_points;
+  initial.max_points = cloud_options_.selector.max_points;
+  initial.backend = toString(params_.backend);
+  reconfigure_->updateConfig(initial);
+  reconfigure_->setCallback(
+      [this](CvoOdometryConfig& config, uint32_t level) { onReconfigure(config, level); });
+  subscribe();
+}
+
+CvoOdometryRos::~CvoOdometryRos() {
+  if (trajectory_file_.empty()) return;
+  Trajectory trajectory;
+  for (const auto& pose : path_.poses) {
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.translation() << pose.pose.position.x, pose.pose.position.y, pose.pose.position.z;
+    p.linear() = Eigen::Quaterniond(pose.pose.orientation.w, pose.pose.orientation.x,
+                                    pose.pose.orientation.y, pose.pose.orientation.z)
+                     .toRotationMatrix();
+    trajectory.append(pose.header.stamp.toSec(), p);
+  }
+  try {
+    writeTrajectory(trajectory_file_, trajectory, TrajectoryFormat::kTum);
+  } catch (const std::exception& e) {
+    ROS_ERROR_STREAM("cvo_odometry: " << e.what());
+  }
+}
+
+void CvoOdometryRos::loadParameters() {
+  std::string preset, mode, backend;
+  pnh_.param<std::string>("preset", preset, "");
+  pnh_.param<std::string>("mode", mode, "rgbd");
+  mode_ = mode == "rgbd"     ? Mode::kRgbd
+          : mode == "stereo" ? Mode::kStereo
+          : mode == "disparity"
+              ? Mode::kDisparity
+              : throw std::invalid_argument("mode must be rgbd, stereo or disparity");
+  if (mode_ != Mode::kRgbd) cloud_options_ = kittiStereoFrontendOptions().cloud;
+  if (!preset.empty()) {
+    params_ = loadCvoParams(preset);
+    loadFrontendParams(preset, &cloud_options_);
+  }
+  // Single parameters override the preset.
+  for (const auto& name : cvoParamNames()) {
+    XmlRpc::XmlRpcValue value;
+    if (!pnh_.getParam(name, value)) continue;
+    std::ostringstream text;
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
+      text << (static_cast<bool>(value) ? "true" : "false");
+    } else if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+      text << static_cast<std::string>(value);
+    } else if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      text << static_cast<int>(value);
+    } else {
+      text.precision(17);
+      text << static_cast<double>(value);
+    }
+    setCvoParam(params_, name, text.str());
+  }
+  override(pnh_, "min_points", &cloud_options_.selector.min_points);
+  override(pnh_, "max_points", &cloud_options_.selector.max_points);
+  override(pnh_, "min_depth", &cloud_options_.min_depth);
+  override(pnh_, "max_depth", &cloud_options_.max_depth);
+  override(pnh_, "crop_top_rows", &cloud_options_.crop_top_rows);
+  std::string selector;
+  if (pnh_.getParam("point_selector", selector)) {
+    cloud_options_.selector.kind = parseSelectorKind(selector);
+  }
+  pnh_.param("use_segmentation", use_segmentation_, false);
+  pnh_.param("semantic_classes", cloud_options_.semantic_classes, 0);
+  pnh_.param("ignore_classes", cloud_options_.ignore_classes, cloud_options_.ignore_classes);
+  if (use_segmentation_ && cloud_options_.semantic_classes < 1) {
+    throw std::invalid_argument("use_segmentation needs semantic_classes >= 1");
+  }
+  if (!use_segmentation_) cloud_options_.semantic_classes = 0;
+  pnh_.param<std::string>("odom_frame", odom_frame_, odom_frame_);
+  pnh_.param<std::string>("base_frame", base_frame_, base_frame_);
+  pnh_.param("publish_tf", publish_tf_, publish_tf_);
+  pnh_.param("depth_units_per_metre", depth_units_per_metre_, depth_units_per_metre_);
+  pnh_.param<std::string>("trajectory_file", trajectory_file_, "");
+  pnh_.param("expected_rate_min", min_rate_, min_rate_);
+  pnh_.param("expected_rate_max", max_rate_, max_rate_);
+  params_.validate();
+  cloud_options_.validate();
+  RgbdFrontendOptions rgbd;
+  rgbd.depth_units_per_metre = depth_units_per_metre_;
+  rgbd.cloud = cloud_options_;
+  rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(rgbd);
+  StereoFrontendOptions stereo;
+  stereo.cloud = cloud_options_;
+  stereo_builder_ = std::make_unique<StereoCloudBuilder>(stereo);
+}
+
+void CvoOdometryRos::subscribe() {
+  int queue = 10;
+  bool approximate = true;
+  pnh_.param("queue_size", queue, queue);
+  pnh_.param("approximate_sync", approximate, approximate);
+  double frame_interval = 0.0;
+  pnh_.param("min_frame_interval", frame_interval, frame_interval);
+  const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
+  auto image = [&](const std::string& topic) {
+    auto filter = std::make_shared<image_transport::SubscriberFilter>(it_, topic, queue, hints);
+    filters_.push_back(filter);
+    return filter;
+  };
+  auto info = [&](const std::string& topic) {
+    auto filter =
+        std::make_shared<message_filters::Subscriber<sensor_msgs::CameraInfo>>(nh_, topic, queue);
+    filters_.push_back(filter);
+    return filter;
+  };
+  if (mode_ == Mode::kRgbd) {
+    // camera_info is not synchronized: the latest one is used (it rarely changes), which keeps
+    // the approximate policy to the two streams whose stamps really differ.
+    rgb_info_sub_ = nh_.subscribe<sensor_msgs::CameraInfo>(
+        "rgb/camera_info", 1, [this](const sensor_msgs::CameraInfoConstPtr& info) {
+          std::lock_guard<std::mutex> lock(info_mutex_);
+          rgb_info_ = info;
+        });
+    auto rgb = image("rgb/image_rect_color");
+    auto depth = image("depth_registered/image_rect");
+    if (use_segmentation_) {
+      auto labels = image("segmentation/image");
+      sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onRgbdWithLabels,
+                          this, *rgb, *depth, *labels);
+    } else {
+      sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onRgbdImages, this,
+                          *rgb, *depth);
+    }
+  } else if (mode_ == Mode::kStereo) {
+    auto left = image("left/image_rect");
+    auto left_info = info("left/camera_info");
+    auto right = image("right/image_rect");
+    auto right_info = info("right/camera_info");
+    sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onStereoImages, this,
+                        *left, *left_info, *right, *right_info);
+  } else {
+    auto left = image("left/image_rect");
+    auto left_info = info("left/camera_info");
+    auto disparity = std::make_shared<message_filters::Subscriber<stereo_msgs::DisparityImage>>(
+        nh_, "disparity", queue);
+    filters_.push_back(disparity);
+    sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onStereoDisparity,
+                        this, *left, *left_info, *disparity);
+  }
+}
+
+void CvoOdometryRos::onRgbdImages(const sensor_msgs::ImageConstPtr& image,
+                                  const sensor_msgs::ImageConstPtr& depth) {
+  onRgbdWithLabels(image, depth, nullptr);
+}
+
+void CvoOdometryRos::onRgbdWithLabels(const sensor_msgs::ImageConstPtr& image,
+                                      const sensor_msgs::ImageConstPtr& depth,
+                                      const sensor_msgs::ImageConstPtr& labels) {
+  sensor_msgs::CameraInfoConstPtr info;
+  {
+    std::lock_guard<std::mutex> lock(info_mutex_);
+    info = rgb_info_;
+  }
+  if (!info) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    skipFrame("no rgb/camera_info received yet");
+    return;
+  }
+  onRgbd(image, info, depth, labels);
+}
+
+void CvoOdometryRos::onStereoImages(const sensor_msgs::ImageConstPtr& left,
+                                    const sensor_msgs::CameraInfoConstPtr& info,
+                                    const sensor_msgs::ImageConstPtr& right,
+                                    const sensor_msgs::CameraInfoConstPtr& right_info) {
+  onStereo(left, info, right, right_info, nullptr);
+}
+
+void CvoOdometryRos::onStereoDisparity(const sensor_msgs::ImageConstPtr& left,
+                                       const sensor_msgs::CameraInfoConstPtr& info,
+                                       const stereo_msgs::DisparityImageConstPtr& disparity) {
+  onStereo(left, info, nullptr, nullptr, disparity);
+}
+
+void CvoOdometryRos::onRgbd(const sensor_msgs::ImageConstPtr& image,
+                            const sensor_msgs::CameraInfoConstPtr& info,
+                            const sensor_msgs::ImageConstPtr& depth,
+                            const sensor_msgs::ImageConstPtr& labels) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  applyPendingConfig();
+  try {
+    RgbdFrame frame;
+    frame.image = colorImageFromMsg(*image);
+    frame.depth = depthImageFromMsg(*depth);
+    frame.intrinsics = intrinsicsFromCameraInfo(*info);
+    if (labels) frame.semantics = labelImageFromMsg(*labels);
+    FrontendStats stats;
+    LabeledCloud cloud = rgbd_builder_->build(frame, &stats);
+    std_msgs::Header header = depth->header;  // the pose is stamped with the depth time
+    header.frame_id =
+        image->header.frame_id.empty() ? depth->header.frame_id : image->header.frame_id;
+    process(header, std::move(cloud), stats);
+  } catch (const std::invalid_argument& e) {
+    skipFrame(e.what());
+  }
+}
+
+void CvoOdometryRos::onStereo(const sensor_msgs::ImageConstPtr& left,
+                              const sensor_msgs::CameraInfoConstPtr& info,
+                              const sensor_msgs::ImageConstPtr& right,
+                              const sensor_msgs::CameraInfoConstPtr& right_info,
+                              const stereo_msgs::DisparityImageConstPtr& disparity) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  applyPendingConfig();
+  try {
+    StereoFrame frame;
+    frame.left = colorImageFromMsg(*left);
+    frame.intrinsics = intrinsicsFromCameraInfo(*info);
+    if (disparity) {
+      if (disparity->image.encoding != sensor_msgs::image_encodings::TYPE_32FC1) {
+        throw std::invalid_argument("disparity image encoding '" + disparity->image.encoding +
+                                    "' is not 32FC1");
+      }
+      frame.disparity = cv_bridge::toCvCopy(disparity->image)->image;
+      frame.baseline = disparity->T;
+    } else {
+      frame.right = colorImageFromMsg(*right);
+      frame.baseline = stereoBaseline(*info, *right_info);
+    }
+    FrontendStats stats;
+    LabeledCloud cloud = stereo_builder_->build(frame, &stats);
+    process(left->header, std::move(cloud), stats);
+  } catch (const std::invalid_argument& e) {
+    skipFrame(e.what());
+  }
+}
+
+void CvoOdometryRos::process(const std_msgs::Header& header, LabeledCloud cloud,
+                             const FrontendStats& stats) {
+  if (last_stamp_ && header.stamp < *last_stamp_) {
+    resetState("time went backwards (" + std::to_string(header.stamp.toSec()) + " after " +
+               std::to_string(last_stamp_->toSec()) + " s): a looping bag? odometry reset");
+  } else if (last_stamp_ && header.stamp == *last_stamp_) {
+    skipFrame("a second frame with stamp " + std::to_string(header.stamp.toSec()));
+    return;
+  }
+  if (!base_from_camera_) base_from_camera_ = baseFromCamera(header.frame_id);
+  // The registration replaces its previous cloud: keep it for the cosine and the debug clouds.
+  std::optional<LabeledCloud> previous;
+  if (odometry_->previousCloud()) previous = *odometry_->previousCloud();
+  OdometryUpdate update;
+  try {
+    update = odometry_->process(header.stamp.toSec(), cloud);
+  } catch (const std::invalid_argument& e) {
+    skipFrame(std::string("registration rejected the frame: ") + e.what());
+    return;
+  }
+  last_stamp_ = header.stamp;
+  ++frames_;
+  double cosine = 1.0;
+  if (!update.first_frame) {
+    if (!update.report.converged) {
+      ++unconverged_;
+      last_problem_ = update.report.message;
+    }
+    if (!update.report.warning.empty()) {
+      ROS_WARN_STREAM_THROTTLE(5.0, "cvo_odometry: " << update.report.warning);
+    }
+    cosine = odometry_->registration().cosine(*previous, cloud, update.motion,
+                                              update.report.final_lengthscale);
+  }
+  publish(header, update, cloud, previous ? previous->size() : 0, stats, cosine);
+  if (previous && previous_cloud_pub_.getNumSubscribers() > 0) {
+    std_msgs::Header previous_header = header;
+    previous_header.stamp = ros::Time(update.stamp - update.dt);
+    previous_cloud_pub_.publish(
+        cloudToMsg(*previous, Eigen::Isometry3f::Identity(), previous_header));
+  }
+}
+
+void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdate& update,
+                             const LabeledCloud& cloud, std::size_t previous_points,
+                             const FrontendStats& stats, double cosine) {
+  const Eigen::Isometry3d& base_T_camera = *base_from_camera_;
+  const Eigen::Isometry3d pose = base_T_camera * update.pose * base_T_camera.inverse();
+  const Eigen::Isometry3d motion = base_T_camera * update.motion * base_T_camera.inverse();
+
+  // Motion covariance in the base frame, accumulated along the path (dead reckoning).
+  Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  if (!update.first_frame) {
+    Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Zero();
+    rotate.topLeftCorner<3, 3>() = rotate.bottomRightCorner<3, 3>() = base_T_camera.rotation();
+    motion_covariance =
+        rotate *
+        registrationCovariance(cloud, update.motion, update.report.final_lengthscale, cosine) *
+        rotate.transpose();
+    pose_covariance_ += motion_covariance;
+  }
+
+  nav_msgs::Odometry odom;
+  odom.header.stamp = header.stamp;
+  odom.header.frame_id = odom_frame_;
+  odom.child_frame_id = base_frame_;
+  odom.pose.pose = toPoseMsg(pose);
+  if (!update.first_frame && update.dt > 0.0) {
+    // The last frame's motion over its interval, in the base frame (child_frame_id).
+    const Eigen::Vector3d omega = lie::logSO3(motion.rotation());
+    odom.twist.twist.linear.x = motion.translation().x() / update.dt;
+    odom.twist.twist.linear.y = motion.translation().y() / update.dt;
+    odom.twist.twist.linear.z = motion.translation().z() / update.dt;
+    odom.twist.twist.angular.x = omega.x() / update.dt;
+    odom.twist.twist.angular.y = omega.y() / update.dt;
+    odom.twist.twist.angular.z = omega.z() / update.dt;
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      odom.pose.covariance[6 * r + c] = pose_covariance_(r, c);
+      odom.twist.covariance[6 * r + c] =
+          update.dt > 0.0 ? motion_covariance(r, c) / (update.dt * update.dt) : 0.0;
+    }
+  }
+  odom_pub_.publish(odom);
+  rate_diagnostic_->tick();
+
+  if (publish_tf_) {
+    geometry_msgs::TransformStamped tf;
+    tf.header = odom.header;
+    tf.child_frame_id = base_frame_;
+    tf.transform = toTransformMsg(pose);
+    tf_broadcaster_.sendTransform(tf);
+  }
+
+  cvo_odometry::CvoIndicator indicator;
+  indicator.header.stamp = header.stamp;
+  indicator.header.frame_id = odom_frame_;
+  indicator.first_frame = update.first_frame;
+  indicator.indicator = update.report.indicator_after;
+  indicator.indicator_before = update.report.indicator_before;
+  indicator.cosine = cosine;
+  indicator.iterations = update.report.iterations;
+  indicator.initial_lengthscale = update.report.initial_lengthscale;
+  indicator.final_lengthscale = update.report.final_lengthscale;
+  indicator.converged = update.first_frame || update.report.converged;
+  indicator.registration_ms = update.report.time_ms;
+  indicator.frontend_ms = stats.time_ms;
+  indicator.source_points = static_cast<uint32_t>(cloud.size());
+  indicator.target_points = static_cast<uint32_t>(previous_points);
+  indicator.backend = update.report.backend;
+  indicator.message = update.first_frame ? "first frame" : update.report.message;
+  indicator_pub_.publish(indicator);
+
+  geometry_msgs::PoseStamped stamped;
+  stamped.header = odom.header;
+  stamped.pose = odom.pose.pose;
+  path_.header = odom.header;
+  path_.poses.push_back(stamped);
+  if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(path_);
+  publishDebugClouds(header, update, cloud);
+}
+
+void CvoOdometryRos::publishDebugClouds(const std_msgs::Header& header,
+                                        const OdometryUpdate& update, const LabeledCloud& cloud) {
+  if (current_cloud_pub_.getNumSubscribers() > 0) {
+    current_cloud_pub_.publish(cloudToMsg(cloud, Eigen::Isometry3f::Identity(), header));
+  }
+  // The current cloud moved into the previous camera frame: it should overlay cloud/previous.
+  if (!update.first_frame && aligned_cloud_pub_.getNumSubscribers() > 0) {
+    aligned_cloud_pub_.publish(cloudToMsg(cloud, update.motion.cast<float>(), header));
+  }
+}
+
+void CvoOdometryRos::skipFrame(const std::string& why) {
+  ++skipped_;
+  last_problem_ = why;
+  ROS_WARN_STREAM_THROTTLE(2.0, "cvo_odometry: frame skipped: " << why);
+}
+
+void CvoOdometryRos::resetState(const std::string& why) {
+  ROS_WARN_STREAM("cvo_odometry: " << why);
+  odometry_->reset();
+  last_stamp_.reset();
+  pose_covariance_.setZero();
+  path_.poses.clear();
+  ++resets_;
+}
+
+bool CvoOdometryRos::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  resetState("reset requested: the next frame starts a new odometry");
+  return true;
+}
+
+void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
+  CvoParams next = params_;
+  next.ell_init = config.ell_init, next.ell_min = config.ell_min;
+  next.ell_first_frame = config.ell_first_frame, next.schedule_decay = config.schedule_decay;
+  next.sigma = config.sigma, next.sp_thres = config.sp_thres;
+  next.use_color = config.use_color, next.color_ell = config.color_ell;
+  next.color_sigma = config.color_sigma, next.use_semantics = config.use_semantics;
+  next.semantic_ell = config.semantic_ell, next.semantic_sigma = config.semantic_sigma;
+  next.max_iterations = config.max_iterations, next.min_step = config.min_step;
+  next.max_step = config.max_step;
+  CloudBuilderOptions cloud = cloud_options_;
+  cloud.selector.min_points = config.min_points;
+  cloud.selector.max_points = config.max_points;
+  try {
+    next.backend = parseBackendChoice(config.backend);
+    next.validate();
+    cloud.validate();
+  } catch (const std::invalid_argument& e) {
+    ROS_ERROR_STREAM("cvo_odometry: reconfigure rejected: " << e.what());
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  pending_params_ = next;
+  pending_cloud_options_ = cloud;
+}
+
+void CvoOdometryRos::applyPendingConfig() {
+  if (pending_params_) {
+    const bool new_backend = pending_params_->backend != params_.backend;
+    params_ = *pending_params_;
+    pending_params_.reset();
+    if (new_backend) {
+      odometry_ = std::make_unique<FrameToFrameOdometry>(params_);
+      last_stamp_.reset();
+      ROS_INFO_STREAM("cvo_odometry: backend now " << odometry_->registration().backend().name()
+                                                   << "; odometry restarted");
+    } else {
+      odometry_->registration().setParams(params_);
+    }
+    ROS_INFO_STREAM("cvo_odometry: parameters updated:\n" << describe(params_, cloud_options_));
+  }
+  if (pending_cloud_options_) {
+    const auto& next = *pending_cloud_options_;
+    if (next.selector.min_points != cloud_options_.selector.min_points ||
+        next.selector.max_points != cloud_options_.selector.max_points) {
+      cloud_options_ = next;
+      RgbdFrontendOptions rgbd;
+      rgbd.depth_units_per_metre = depth_units_per_metre_;
+      rgbd.cloud = cloud_options_;
+      rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(rgbd);
+      StereoFrontendOptions stereo;
+      stereo.cloud = cloud_options_;
+      stereo_builder_ = std::make_unique<StereoCloudBuilder>(stereo);
+    }
+    pending_cloud_options_.reset();
+  }
+}
+
+Eigen::Isometry3d CvoOdometryRos::baseFromCamera(const std::string& camera_frame) {
+  if (camera_frame.empty() || camera_frame == base_frame_) return Eigen::Isometry3d::Identity();
+  try {
+    const auto tf =
+        tf_buffer_.lookupTransform(base_frame_, camera_frame, ros::Time(0), ros::Duration(0.5));
+    return fromTransformMsg(tf.transform);
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_STREAM("cvo_odometry: no transform " << base_frame_ << " <- " << camera_frame << " ("
+                                                  << e.what()
+                                                  << "); using identity: odometry of the camera");
+    return Eigen::Isometry3d::Identity();
+  }
+}
+
+void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (frames_ == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame processed yet");
+  } else if (!last_problem_.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, last_problem_);
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
+  }
+  status.add("frames", frames_);
+  status.add("skipped frames", skipped_);
+  status.add("unconverged registrations", unconverged_);
+  status.add("resets", resets_);
+  status.add("backend", odometry_->registration().backend().name());
+  last_problem_.clear();
+}
+
+}  // namespace cvo

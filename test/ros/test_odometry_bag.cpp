@@ -1,0 +1,154 @@
+// rostest node: a recorded bag of the fixture is played into the nodelet; this node collects its
+// odometry and indicator messages and checks them against the fixture's ground truth.
+// Parameters (private): ground_truth, ground_truth_times (KITTI), stamp_offset (s added to the
+// ground truth's stamps, as cvo_make_bag does for KITTI), frames (expected), min_frames (fewest
+// accepted: approximate sync may drop a pair), max_final_error_m, max_rpe_m and max_rpe_deg (per
+// frame) or max_rpe_mps and max_rpe_dps (per second), timeout_s, nearest_association.
+#include <gtest/gtest.h>
+
+#include <mutex>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "cvo_odometry/CvoIndicator.h"
+#include "cvo_odometry/core/evaluation_report.hpp"
+#include "cvo_odometry/core/trajectory_io.hpp"
+
+namespace {
+
+struct Collected {
+  std::mutex mutex;
+  std::vector<nav_msgs::Odometry> odometry;
+  std::vector<cvo_odometry::CvoIndicator> indicators;
+};
+
+Eigen::Isometry3d poseOf(const nav_msgs::Odometry& msg) {
+  const auto& p = msg.pose.pose;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << p.position.x, p.position.y, p.position.z;
+  pose.linear() =
+      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
+          .toRotationMatrix();
+  return pose;
+}
+
+TEST(OdometryBag, TracksTheFixtureWithinBounds) {
+  ros::NodeHandle nh, pnh("~");
+  std::string gt_path, gt_times;
+  int frames = 0, min_frames = 0;
+  double offset = 0.0, max_final = 0.0, timeout = 60.0;
+  double max_rpe_m = 1e9, max_rpe_deg = 1e9, max_rpe_mps = 1e9, max_rpe_dps = 1e9;
+  ASSERT_TRUE(pnh.getParam("ground_truth", gt_path));
+  pnh.param<std::string>("ground_truth_times", gt_times, "");
+  ASSERT_TRUE(pnh.getParam("frames", frames));
+  pnh.param("min_frames", min_frames, frames);
+  pnh.param("stamp_offset", offset, 0.0);
+  ASSERT_TRUE(pnh.getParam("max_final_error_m", max_final));
+  pnh.param("max_rpe_m", max_rpe_m, max_rpe_m);
+  pnh.param("max_rpe_deg", max_rpe_deg, max_rpe_deg);
+  pnh.param("max_rpe_mps", max_rpe_mps, max_rpe_mps);
+  pnh.param("max_rpe_dps", max_rpe_dps, max_rpe_dps);
+  pnh.param("timeout_s", timeout, timeout);
+
+  Collected collected;
+  auto odom_sub =
+      nh.subscribe<nav_msgs::Odometry>("odom", 100, [&](const nav_msgs::Odometry::ConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(collected.mutex);
+        collected.odometry.push_back(*msg);
+      });
+  auto indicator_sub = nh.subscribe<cvo_odometry::CvoIndicator>(
+      "indicator", 100, [&](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(collected.mutex);
+        collected.indicators.push_back(*msg);
+      });
+  tf2_ros::Buffer tf_buffer;
+  tf2_ros::TransformListener tf_listener(tf_buffer);
+
+  // Until every frame came, or enough came and nothing more for 8 s (the bag has ended).
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+  std::size_t seen = 0;
+  ros::WallTime last_change = ros::WallTime::now();
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    {
+      std::lock_guard<std::mutex> lock(collected.mutex);
+      const std::size_t n = collected.indicators.size();
+      if (static_cast<int>(n) >= frames) break;
+      if (n != seen) seen = n, last_change = ros::WallTime::now();
+      if (static_cast<int>(n) >= min_frames &&
+          ros::WallTime::now() - last_change > ros::WallDuration(8.0))
+        break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  std::lock_guard<std::mutex> lock(collected.mutex);
+  ASSERT_GE(static_cast<int>(collected.indicators.size()), min_frames);
+  ASSERT_LE(static_cast<int>(collected.indicators.size()), frames);
+  ASSERT_EQ(collected.odometry.size(), collected.indicators.size()) << "one indicator per frame";
+  EXPECT_TRUE(collected.indicators.front().first_frame);
+  for (std::size_t k = 1; k < collected.indicators.size(); ++k) {
+    const auto& indicator = collected.indicators[k];
+    EXPECT_FALSE(indicator.first_frame) << "frame " << k;
+    EXPECT_TRUE(indicator.converged) << "frame " << k << ": " << indicator.message;
+    EXPECT_GT(indicator.iterations, 0);
+    EXPECT_GT(indicator.cosine, 0.0);
+    EXPECT_LE(indicator.cosine, 1.0 + 1e-9);
+    EXPECT_GT(indicator.source_points, 1000u);
+    EXPECT_GT(indicator.target_points, 1000u);
+  }
+  const auto& last = collected.odometry.back();
+  EXPECT_EQ(last.header.frame_id, "odom");
+  EXPECT_EQ(last.child_frame_id, "base_link");
+  EXPECT_GT(last.pose.covariance[0], 0.0) << "covariance filled in";
+
+  // TF odom -> base_link available at the last stamp.
+  EXPECT_TRUE(tf_buffer.canTransform("odom", "base_link", last.header.stamp, ros::Duration(2.0)));
+
+  cvo::Trajectory estimate;
+  for (const auto& msg : collected.odometry)
+    estimate.append(msg.header.stamp.toSec() - offset, poseOf(msg));
+  const cvo::Trajectory ground_truth =
+      cvo::readTrajectory(gt_path, cvo::detectTrajectoryFormat(gt_path), gt_times);
+  // Final pose relative to the first, against the ground truth's.
+  auto truthAt = [&](double stamp, Eigen::Isometry3d* pose) {
+    if (ground_truth.interpolate(stamp, 0.05, pose)) return true;
+    const long k = ground_truth.nearest(stamp, 0.01);  // at the ends of a sparse ground truth
+    if (k >= 0) *pose = ground_truth[static_cast<std::size_t>(k)].pose;
+    return k >= 0;
+  };
+  Eigen::Isometry3d gt_first, gt_last;
+  ASSERT_TRUE(truthAt(estimate[0].stamp, &gt_first));
+  ASSERT_TRUE(truthAt(estimate[estimate.size() - 1].stamp, &gt_last));
+  const Eigen::Isometry3d gt_motion = gt_first.inverse() * gt_last;
+  const Eigen::Isometry3d est_motion =
+      estimate[0].pose.inverse() * estimate[estimate.size() - 1].pose;
+  const double final_error = (gt_motion.translation() - est_motion.translation()).norm();
+  std::cout << "final position error " << final_error << " m over "
+            << gt_motion.translation().norm() << " m\n";
+  EXPECT_LT(final_error, max_final);
+
+  cvo::EvaluationOptions options;
+  bool nearest = false;  // KITTI ground truth: one pose per frame, no interpolation
+  pnh.param("nearest_association", nearest, nearest);
+  if (nearest) options.association = cvo::Association::kNearest;
+  const auto report = cvo::evaluateTrajectory(ground_truth, estimate, options);
+  cvo::printEvaluationReport(std::cout, report, options);
+  EXPECT_LT(report.rpe_frame.translation_rmse, max_rpe_m);
+  EXPECT_LT(report.rpe_frame.rotation_rmse_deg, max_rpe_deg);
+  EXPECT_LT(report.rpe_frame.translation_rate_rmse, max_rpe_mps);
+  EXPECT_LT(report.rpe_frame.rotation_rate_rmse_deg, max_rpe_dps);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_odometry_bag");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  spinner.stop();
+  return result;
+}
