@@ -225,6 +225,7 @@ void CvoOdometryRos::subscribe() {
           rgb_info_ = info;
         });
     auto rgb = image("rgb/image_rect_color");
+    countArrivals(*rgb);
     auto depth = image("depth_registered/image_rect");
     if (use_segmentation_) {
       auto labels = image("segmentation/image");
@@ -236,6 +237,7 @@ void CvoOdometryRos::subscribe() {
     }
   } else if (mode_ == Mode::kStereo) {
     auto left = image("left/image_rect");
+    countArrivals(*left);
     auto left_info = info("left/camera_info");
     auto right = image("right/image_rect");
     auto right_info = info("right/camera_info");
@@ -243,6 +245,7 @@ void CvoOdometryRos::subscribe() {
                         *left, *left_info, *right, *right_info);
   } else {
     auto left = image("left/image_rect");
+    countArrivals(*left);
     auto left_info = info("left/camera_info");
     auto disparity = std::make_shared<message_filters::Subscriber<stereo_msgs::DisparityImage>>(
         nh_, "disparity", queue);
@@ -250,6 +253,12 @@ void CvoOdometryRos::subscribe() {
     sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onStereoDisparity,
                         this, *left, *left_info, *disparity);
   }
+}
+
+void CvoOdometryRos::countArrivals(image_transport::SubscriberFilter& images) {
+  // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
+  images.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const sensor_msgs::ImageConstPtr&) { ++arrived_; }));
 }
 
 void CvoOdometryRos::onRgbdImages(const sensor_msgs::ImageConstPtr& image,
@@ -577,6 +586,8 @@ void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   }
   status.add("frames", frames_);
   status.add("skipped frames", skipped_);
+  const std::size_t handled = frames_ + skipped_;
+  status.add("frames not synchronized", arrived_ > handled ? arrived_ - handled : 0);
   status.add("unconverged registrations", unconverged_);
   status.add("resets", resets_);
   status.add("backend", odometry_->registration().backend().name());

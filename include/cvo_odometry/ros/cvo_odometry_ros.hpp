@@ -49,6 +49,7 @@ class CvoOdometryRos {
   void subscribe();
   void onRgbd(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info,
               const sensor_msgs::ImageConstPtr& depth, const sensor_msgs::ImageConstPtr& labels);
+  void countArrivals(image_transport::SubscriberFilter& images);
   void onRgbdImages(const sensor_msgs::ImageConstPtr& image,
                     const sensor_msgs::ImageConstPtr& depth);
   void onRgbdWithLabels(const sensor_msgs::ImageConstPtr& image,
@@ -102,6 +103,7 @@ class CvoOdometryRos {
   nav_msgs::Path path_;
 
   std::size_t frames_ = 0, skipped_ = 0, unconverged_ = 0, resets_ = 0;
+  std::atomic<std::size_t> arrived_{0};  // images of the main stream, before synchronization
   std::string last_problem_;
 
   image_transport::ImageTransport it_;
