@@ -15,6 +15,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 cvo_configure
+[ "$rviz" = false ] || "$CVO_ROOT/scripts/install_deps.sh" viz
 cmake --build "$CVO_BUILD" -j"$(cvo_jobs)" --target cvo_make_bag cvo_odometry_nodelet cvo_evaluate
 set +u  # the devel setup reads unset variables
 source "$CVO_BUILD/devel/setup.bash"

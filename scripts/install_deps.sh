@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cvo_odometry needs; quick and quiet when they are all present.
-# Usage: scripts/install_deps.sh [core|full|peers]
-#   core: CMake, compiler, Eigen, GoogleTest; full: + OpenCV and ROS; peers: + PCL, Open3D, contrib
+# Usage: scripts/install_deps.sh [core|full|peers|viz]
+#   core: CMake, compiler, Eigen, GoogleTest; full: + OpenCV and ROS; peers: + PCL, Open3D,
+#   OpenCV contrib; viz: full + rviz
 set -euo pipefail
 profile=${1:-full}
 
@@ -15,7 +16,9 @@ full=("${core[@]}" libopencv-dev clang-format
   ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-stereo-msgs libstereo-msgs-dev
   libcv-bridge-dev libimage-transport-dev libdiagnostic-updater-dev libdiagnostic-msgs-dev
   ros-diagnostic-msgs libstereo-image-proc-dev ros-stereo-image-proc python3-matplotlib
-  libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev rviz)
+  libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev)
+# rviz only for watching (scripts/demo.sh --rviz): large, not needed by the tests.
+viz=("${full[@]}" rviz)
 # Peers for bench/peer_table.sh only (large: PCL, Open3D, OpenCV contrib).
 peers=(libopencv-contrib-dev libpcl-dev python3-open3d python3-numpy)
 
@@ -23,7 +26,8 @@ case "$profile" in
   core) wanted=("${core[@]}") ;;
   full) wanted=("${full[@]}") ;;
   peers) wanted=("${full[@]}" "${peers[@]}") ;;
-  *) echo "usage: $0 [core|full|peers]" >&2; exit 2 ;;
+  viz) wanted=("${viz[@]}") ;;
+  *) echo "usage: $0 [core|full|peers|viz]" >&2; exit 2 ;;
 esac
 
 missing=()
