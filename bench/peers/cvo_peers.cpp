@@ -48,20 +48,20 @@ Cloud::Ptr toPcl(const cvo::LabeledCloud& cloud, double voxel) {
 // previous <- current by PCL registration of the current cloud (source) to the previous.
 Eigen::Matrix4d pclMotion(const std::string& method, const Cloud::Ptr& previous,
                           const Cloud::Ptr& current, const Eigen::Matrix4d& guess,
-                          double ndt_resolution) {
+                          double resolution) {
   Cloud aligned;
   if (method == "pcl_gicp") {
     pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
     gicp.setInputSource(current);
     gicp.setInputTarget(previous);
-    gicp.setMaxCorrespondenceDistance(ndt_resolution);
+    gicp.setMaxCorrespondenceDistance(resolution);
     gicp.align(aligned, guess.cast<float>());
     return gicp.getFinalTransformation().cast<double>();
   }
   pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
-  ndt.setResolution(static_cast<float>(ndt_resolution));
+  ndt.setResolution(static_cast<float>(resolution));
   ndt.setTransformationEpsilon(1e-4);
-  ndt.setStepSize(0.1 * ndt_resolution);
+  ndt.setStepSize(0.1 * resolution);
   ndt.setMaximumIterations(50);
   ndt.setInputSource(current);
   ndt.setInputTarget(previous);
@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
     const bool tum = input.kind == "tum";
     // TUM: PCL on every valid depth pixel (then a voxel grid); KITTI: our stereo clouds.
     double voxel = cli.getDouble("voxel", tum ? 0.01 : 0.0);
+    // NDT cell size, and the largest GICP correspondence distance (m).
     double resolution = cli.getDouble("resolution", tum ? 0.1 : 1.0);
 
     std::unique_ptr<cvo::TumSequence> tum_sequence;

@@ -35,10 +35,6 @@ int toInt(const std::string& key, const std::string& value) {
 
 }  // namespace
 
-std::vector<std::string> frontendParamNames() {
-  return frontendPresetKeys();  // one list, owned by the preset reader
-}
-
 void setFrontendParam(CloudBuilderOptions& options, const std::string& key,
                       const std::string& value) {
   if (key == "point_selector") {

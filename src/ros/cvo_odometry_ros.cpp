@@ -3,12 +3,10 @@
 #include <fstream>
 #include <sstream>
 
-#include <cv_bridge/cv_bridge.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
 #include <message_filters/synchronizer.h>
 #include <nav_msgs/Odometry.h>
-#include <sensor_msgs/image_encodings.h>
 #include <boost/function.hpp>
 
 #include "cvo_odometry/CvoIndicator.h"
@@ -188,6 +186,10 @@ void CvoOdometryRos::loadParameters() {
   pnh_.param("expected_rate_max", max_rate_, max_rate_);
   params_.validate();
   cloud_options_.validate();
+  makeCloudBuilders();
+}
+
+void CvoOdometryRos::makeCloudBuilders() {
   RgbdFrontendOptions rgbd;
   rgbd.depth_units_per_metre = depth_units_per_metre_;
   rgbd.cloud = cloud_options_;
@@ -330,11 +332,7 @@ void CvoOdometryRos::onStereo(const sensor_msgs::ImageConstPtr& left,
     frame.left = colorImageFromMsg(*left);
     frame.intrinsics = intrinsicsFromCameraInfo(*info);
     if (disparity) {
-      if (disparity->image.encoding != sensor_msgs::image_encodings::TYPE_32FC1) {
-        throw std::invalid_argument("disparity image encoding '" + disparity->image.encoding +
-                                    "' is not 32FC1");
-      }
-      frame.disparity = cv_bridge::toCvCopy(disparity->image)->image;
+      frame.disparity = disparityImageFromMsg(*disparity);
       frame.baseline = disparity->T;
     } else {
       frame.right = colorImageFromMsg(*right);
@@ -530,6 +528,15 @@ void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
 }
 
 void CvoOdometryRos::applyPendingConfig() {
+  if (pending_cloud_options_) {
+    const auto& next = *pending_cloud_options_;
+    if (next.selector.min_points != cloud_options_.selector.min_points ||
+        next.selector.max_points != cloud_options_.selector.max_points) {
+      cloud_options_ = next;
+      makeCloudBuilders();
+    }
+    pending_cloud_options_.reset();
+  }
   if (pending_params_) {
     const bool new_backend = pending_params_->backend != params_.backend;
     params_ = *pending_params_;
@@ -543,21 +550,6 @@ void CvoOdometryRos::applyPendingConfig() {
       odometry_->registration().setParams(params_);
     }
     ROS_INFO_STREAM("cvo_odometry: parameters updated:\n" << describe(params_, cloud_options_));
-  }
-  if (pending_cloud_options_) {
-    const auto& next = *pending_cloud_options_;
-    if (next.selector.min_points != cloud_options_.selector.min_points ||
-        next.selector.max_points != cloud_options_.selector.max_points) {
-      cloud_options_ = next;
-      RgbdFrontendOptions rgbd;
-      rgbd.depth_units_per_metre = depth_units_per_metre_;
-      rgbd.cloud = cloud_options_;
-      rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(rgbd);
-      StereoFrontendOptions stereo;
-      stereo.cloud = cloud_options_;
-      stereo_builder_ = std::make_unique<StereoCloudBuilder>(stereo);
-    }
-    pending_cloud_options_.reset();
   }
 }
 

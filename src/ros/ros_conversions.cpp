@@ -25,7 +25,7 @@ void checkImage(const sensor_msgs::Image& msg, const char* what) {
   }
 }
 
-cv::Mat share(const sensor_msgs::Image& msg, const char* what) {
+cv::Mat copyToMat(const sensor_msgs::Image& msg, const char* what) {
   try {
     return cv_bridge::toCvCopy(msg)->image;
   } catch (const cv_bridge::Exception& e) {
@@ -89,7 +89,7 @@ cv::Mat depthImageFromMsg(const sensor_msgs::Image& msg) {
     throw std::invalid_argument("depth image encoding '" + e +
                                 "' is not supported (16UC1 millimetres or 32FC1 metres)");
   }
-  return share(msg, "depth");
+  return copyToMat(msg, "depth");
 }
 
 cv::Mat labelImageFromMsg(const sensor_msgs::Image& msg) {
@@ -102,7 +102,16 @@ cv::Mat labelImageFromMsg(const sensor_msgs::Image& msg) {
     throw std::invalid_argument("segmentation encoding '" + e +
                                 "' is not supported (8/16-bit class ids or 32FC<N>)");
   }
-  return share(msg, "segmentation");
+  return copyToMat(msg, "segmentation");
+}
+
+cv::Mat disparityImageFromMsg(const stereo_msgs::DisparityImage& msg) {
+  checkImage(msg.image, "disparity");
+  if (msg.image.encoding != enc::TYPE_32FC1) {
+    throw std::invalid_argument("disparity image encoding '" + msg.image.encoding +
+                                "' is not 32FC1");
+  }
+  return copyToMat(msg.image, "disparity");
 }
 
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) {

@@ -1,6 +1,6 @@
 // The front end's keys in the flat YAML presets of config/ (beside the CVO parameters; the same
-// keys the nodelet reads as ROS parameters): point_selector, min_points, max_points, min_depth,
-// max_depth, crop_top_rows.
+// keys the nodelet reads as ROS parameters). The list itself is core's frontendPresetKeys(),
+// which the CVO preset reader skips.
 #pragma once
 
 #include <string>
@@ -9,8 +9,6 @@
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 namespace cvo {
-
-std::vector<std::string> frontendParamNames();
 
 // Throws std::invalid_argument for an unknown key or a bad value.
 void setFrontendParam(CloudBuilderOptions& options, const std::string& key,

@@ -46,6 +46,9 @@ class CvoOdometryRos {
   enum class Mode { kRgbd, kStereo, kDisparity };
 
   void loadParameters();
+  // The RGB-D and stereo front ends from cloud_options_ (at start and when the point range
+  // changes).
+  void makeCloudBuilders();
   void subscribe();
   void onRgbd(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info,
               const sensor_msgs::ImageConstPtr& depth, const sensor_msgs::ImageConstPtr& labels);

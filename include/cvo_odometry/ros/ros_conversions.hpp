@@ -7,6 +7,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <stereo_msgs/DisparityImage.h>
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
@@ -28,6 +29,8 @@ cv::Mat colorImageFromMsg(const sensor_msgs::Image& msg);
 cv::Mat depthImageFromMsg(const sensor_msgs::Image& msg);
 // Segmentation: 8/16-bit class ids (mono8, mono16, 8UC1, 16UC1) or 32FC<N> probabilities.
 cv::Mat labelImageFromMsg(const sensor_msgs::Image& msg);
+// The 32FC1 disparity (pixels) of stereo_image_proc's DisparityImage.
+cv::Mat disparityImageFromMsg(const stereo_msgs::DisparityImage& msg);
 
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose);
 geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& pose);
