@@ -60,6 +60,11 @@ void CvoParams::validate() const {
   require(max_iterations >= 1, "max_iterations must be >= 1");
   require(max_level_iterations >= 1, "max_level_iterations must be >= 1");
   require(num_threads >= 0, "num_threads must be >= 0");
+  require(min_cosine >= 0.0 && min_cosine < 1.0, "min_cosine must be in [0, 1)");
+  require(min_tracking_points >= 1, "min_tracking_points must be >= 1");
+  requirePositive(max_linear_speed, "max_linear_speed");
+  requirePositive(max_angular_speed, "max_angular_speed");
+  require(max_lost_frames >= 0, "max_lost_frames must be >= 0");
 }
 
 double CvoParams::maxKernelWeight() const {
@@ -82,6 +87,25 @@ std::string toString(BackendChoice backend) {
     default:
       return "auto";
   }
+}
+
+std::string toString(LostFramePolicy policy) {
+  switch (policy) {
+    case LostFramePolicy::kPublishNothing:
+      return "publish_nothing";
+    case LostFramePolicy::kReset:
+      return "reset";
+    default:
+      return "keep_guess";
+  }
+}
+
+LostFramePolicy parseLostFramePolicy(const std::string& name) {
+  if (name == "keep_guess") return LostFramePolicy::kKeepGuess;
+  if (name == "publish_nothing") return LostFramePolicy::kPublishNothing;
+  if (name == "reset") return LostFramePolicy::kReset;
+  throw std::invalid_argument("unknown lost_frame_policy '" + name +
+                              "' (keep_guess, publish_nothing or reset)");
 }
 
 StepMethod parseStepMethod(const std::string& name) {

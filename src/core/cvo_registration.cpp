@@ -240,9 +240,11 @@ double CvoRegistration::indicator(const LabeledCloud& target, const LabeledCloud
 double CvoRegistration::cosine(const LabeledCloud& target, const LabeledCloud& source,
                                const Eigen::Isometry3d& T, double ell) {
   const double cross = innerProduct(target, source, T, ell);
-  const double self_target = innerProduct(target, target, Eigen::Isometry3d::Identity(), ell);
-  const double self_source = innerProduct(source, source, Eigen::Isometry3d::Identity(), ell);
-  return cross / std::sqrt(self_target * self_source);
+  return cross / std::sqrt(selfProduct(target, ell) * selfProduct(source, ell));
+}
+
+double CvoRegistration::selfProduct(const LabeledCloud& cloud, double ell) {
+  return innerProduct(cloud, cloud, Eigen::Isometry3d::Identity(), ell);
 }
 
 }  // namespace cvo

@@ -45,6 +45,11 @@ void visitScalars(Params& p, Visitor&& f) {
   f("max_overrelaxation", p.max_overrelaxation);
   f("max_level_iterations", p.max_level_iterations);
   f("num_threads", p.num_threads);
+  f("min_cosine", p.min_cosine);
+  f("min_tracking_points", p.min_tracking_points);
+  f("max_linear_speed", p.max_linear_speed);
+  f("max_angular_speed", p.max_angular_speed);
+  f("max_lost_frames", p.max_lost_frames);
 }
 
 void parseValue(const std::string& key, const std::string& text, double& out) {
@@ -100,6 +105,10 @@ void setCvoParam(CvoParams& params, const std::string& key, const std::string& v
     params.backend = parseBackendChoice(value);
     return;
   }
+  if (key == "lost_frame_policy") {
+    params.lost_frame_policy = parseLostFramePolicy(value);
+    return;
+  }
   bool found = false;
   visitScalars(params, [&](const char* name, auto& member) {
     if (key == name) {
@@ -111,7 +120,7 @@ void setCvoParam(CvoParams& params, const std::string& key, const std::string& v
 }
 
 std::vector<std::string> cvoParamNames() {
-  std::vector<std::string> names{"step_method", "backend"};
+  std::vector<std::string> names{"step_method", "backend", "lost_frame_policy"};
   CvoParams p;
   visitScalars(p, [&](const char* name, auto&) { names.emplace_back(name); });
   return names;
@@ -171,6 +180,7 @@ CvoParams loadCvoParams(const std::string& path, const CvoParams& base) {
 void writeCvoParams(std::ostream& out, const CvoParams& params) {
   out << "step_method: " << toString(params.step_method) << "\n";
   out << "backend: " << toString(params.backend) << "\n";
+  out << "lost_frame_policy: " << toString(params.lost_frame_policy) << "\n";
   CvoParams copy = params;
   visitScalars(copy, [&](const char* name, auto& member) {
     using T = std::decay_t<decltype(member)>;

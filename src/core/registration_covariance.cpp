@@ -1,6 +1,7 @@
 #include "cvo_odometry/core/registration_covariance.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <Eigen/Cholesky>
 
@@ -30,6 +31,15 @@ Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
   Matrix6d covariance = ldlt.solve(Matrix6d::Identity());
   covariance = 0.5 * (covariance + covariance.transpose());
   return covariance / std::clamp(cosine, 1e-3, 1.0);
+}
+
+Eigen::Matrix<double, 6, 6> guessedMotionCovariance(const CvoParams& params, double dt) {
+  const double translation = params.max_linear_speed * dt;
+  const double rotation = params.max_angular_speed * M_PI / 180.0 * dt;
+  Eigen::Matrix<double, 6, 1> variances;
+  variances << Eigen::Vector3d::Constant(translation * translation),
+      Eigen::Vector3d::Constant(rotation * rotation);
+  return variances.asDiagonal();
 }
 
 }  // namespace cvo

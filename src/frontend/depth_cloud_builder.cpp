@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "cvo_odometry/frontend/color_features.hpp"
+#include "cvo_odometry/frontend/empty_frame_error.hpp"
 #include "cvo_odometry/frontend/semantic_image.hpp"
 
 namespace cvo {
@@ -85,7 +86,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   cv::Mat valid = (depth == depth);  // false for NaN
   valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
-  if (valid_count == 0) throw std::invalid_argument("no pixel has valid depth");
+  if (valid_count == 0) throw EmptyFrameError("no pixel has valid depth");
   const cv::Mat grey = toGrey(image);
   const cv::Mat features = colorFeatures(image);
   FrontendStats local;
@@ -105,7 +106,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
               semantics ? probabilities.data() : nullptr);
   }
   if (cloud.size() == 0) {
-    throw std::invalid_argument("every selected pixel belongs to an ignored class");
+    throw EmptyFrameError("every selected pixel belongs to an ignored class");
   }
   local.valid_depth_pixels = valid_count;
   local.time_ms =

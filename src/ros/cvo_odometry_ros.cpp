@@ -10,10 +10,15 @@
 #include <boost/function.hpp>
 
 #include "cvo_odometry/CvoIndicator.h"
+#include "cvo_odometry/core/backend_factory.hpp"
+#include "cvo_odometry/core/cpu_backend.hpp"
+#include "cvo_odometry/core/failover_backend.hpp"
+#include "cvo_odometry/core/fault_injection_backend.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/registration_covariance.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/empty_frame_error.hpp"
 #include "cvo_odometry/frontend/frontend_params.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
 
@@ -68,7 +73,7 @@ std::string describe(const CvoParams& params, const CloudBuilderOptions& cloud) 
 CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), it_(nh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
   loadParameters();
-  odometry_ = std::make_unique<FrameToFrameOdometry>(params_);
+  makeOdometry();
   ROS_INFO_STREAM("cvo_odometry: mode "
                   << (mode_ == Mode::kRgbd     ? "rgbd"
                       : mode_ == Mode::kStereo ? "stereo"
@@ -106,6 +111,12 @@ CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   initial.max_step = params_.max_step, initial.min_points = cloud_options_.selector.min_points;
   initial.max_points = cloud_options_.selector.max_points;
   initial.backend = toString(params_.backend);
+  initial.min_cosine = params_.min_cosine;
+  initial.min_tracking_points = params_.min_tracking_points;
+  initial.max_linear_speed = params_.max_linear_speed;
+  initial.max_angular_speed = params_.max_angular_speed;
+  initial.lost_frame_policy = toString(params_.lost_frame_policy);
+  initial.max_lost_frames = params_.max_lost_frames;
   reconfigure_->updateConfig(initial);
   reconfigure_->setCallback(
       [this](CvoOdometryConfig& config, uint32_t level) { onReconfigure(config, level); });
@@ -182,6 +193,7 @@ void CvoOdometryRos::loadParameters() {
   pnh_.param("publish_tf", publish_tf_, publish_tf_);
   pnh_.param("depth_units_per_metre", depth_units_per_metre_, depth_units_per_metre_);
   pnh_.param<std::string>("trajectory_file", trajectory_file_, "");
+  pnh_.param("inject_backend_fault_after", inject_backend_fault_after_, -1);
   pnh_.param("expected_rate_min", min_rate_, min_rate_);
   pnh_.param("expected_rate_max", max_rate_, max_rate_);
   params_.validate();
@@ -303,21 +315,20 @@ void CvoOdometryRos::onRgbd(const sensor_msgs::ImageConstPtr& image,
                             const sensor_msgs::ImageConstPtr& labels) {
   std::lock_guard<std::mutex> lock(mutex_);
   applyPendingConfig();
+  RgbdFrame frame;
   try {
-    RgbdFrame frame;
     frame.image = colorImageFromMsg(*image);
     frame.depth = depthImageFromMsg(*depth);
     frame.intrinsics = intrinsicsFromCameraInfo(*info);
     if (labels) frame.semantics = labelImageFromMsg(*labels);
-    FrontendStats stats;
-    LabeledCloud cloud = rgbd_builder_->build(frame, &stats);
-    std_msgs::Header header = depth->header;  // the pose is stamped with the depth time
-    header.frame_id =
-        image->header.frame_id.empty() ? depth->header.frame_id : image->header.frame_id;
-    process(header, std::move(cloud), stats);
   } catch (const std::invalid_argument& e) {
     skipFrame(e.what());
+    return;
   }
+  std_msgs::Header header = depth->header;  // the pose is stamped with the depth time
+  header.frame_id =
+      image->header.frame_id.empty() ? depth->header.frame_id : image->header.frame_id;
+  buildAndProcess(header, [&](FrontendStats* stats) { return rgbd_builder_->build(frame, stats); });
 }
 
 void CvoOdometryRos::onStereo(const sensor_msgs::ImageConstPtr& left,
@@ -327,8 +338,8 @@ void CvoOdometryRos::onStereo(const sensor_msgs::ImageConstPtr& left,
                               const stereo_msgs::DisparityImageConstPtr& disparity) {
   std::lock_guard<std::mutex> lock(mutex_);
   applyPendingConfig();
+  StereoFrame frame;
   try {
-    StereoFrame frame;
     frame.left = colorImageFromMsg(*left);
     frame.intrinsics = intrinsicsFromCameraInfo(*info);
     if (disparity) {
@@ -338,16 +349,29 @@ void CvoOdometryRos::onStereo(const sensor_msgs::ImageConstPtr& left,
       frame.right = colorImageFromMsg(*right);
       frame.baseline = stereoBaseline(*info, *right_info);
     }
-    FrontendStats stats;
-    LabeledCloud cloud = stereo_builder_->build(frame, &stats);
-    process(left->header, std::move(cloud), stats);
   } catch (const std::invalid_argument& e) {
     skipFrame(e.what());
+    return;
+  }
+  buildAndProcess(left->header,
+                  [&](FrontendStats* stats) { return stereo_builder_->build(frame, stats); });
+}
+
+void CvoOdometryRos::buildAndProcess(const std_msgs::Header& header,
+                                     const std::function<LabeledCloud(FrontendStats*)>& build) {
+  FrontendStats stats;
+  try {
+    process(header, build(&stats), "", stats);
+  } catch (const EmptyFrameError& e) {
+    // Well-formed but nothing to track (no valid depth): a lost frame, reported as such.
+    process(header, std::nullopt, e.what(), stats);
+  } catch (const std::invalid_argument& e) {
+    skipFrame(e.what());  // inconsistent input (sizes, calibration): not a frame at all
   }
 }
 
-void CvoOdometryRos::process(const std_msgs::Header& header, LabeledCloud cloud,
-                             const FrontendStats& stats) {
+void CvoOdometryRos::process(const std_msgs::Header& header, std::optional<LabeledCloud> cloud,
+                             const std::string& why_no_cloud, const FrontendStats& stats) {
   if (last_stamp_ && header.stamp < *last_stamp_) {
     resetState("time went backwards (" + std::to_string(header.stamp.toSec()) + " after " +
                std::to_string(last_stamp_->toSec()) + " s): a looping bag? odometry reset");
@@ -356,57 +380,108 @@ void CvoOdometryRos::process(const std_msgs::Header& header, LabeledCloud cloud,
     return;
   }
   if (!base_from_camera_) base_from_camera_ = baseFromCamera(header.frame_id);
-  // The registration replaces its previous cloud: keep it for the cosine and the debug clouds.
-  std::optional<LabeledCloud> previous;
-  if (odometry_->previousCloud()) previous = *odometry_->previousCloud();
+  // The reference is replaced when the frame is good: copy it only for a subscriber.
+  std::optional<LabeledCloud> reference;
+  if (odometry_->referenceCloud() && previous_cloud_pub_.getNumSubscribers() > 0) {
+    reference = *odometry_->referenceCloud();
+  }
   OdometryUpdate update;
   try {
-    update = odometry_->process(header.stamp.toSec(), cloud);
+    update = cloud ? odometry_->process(header.stamp.toSec(), *cloud)
+                   : odometry_->processLostFrame(header.stamp.toSec(), why_no_cloud);
   } catch (const std::invalid_argument& e) {
     skipFrame(std::string("registration rejected the frame: ") + e.what());
     return;
   }
   last_stamp_ = header.stamp;
   ++frames_;
-  double cosine = 1.0;
-  if (!update.first_frame) {
-    if (!update.report.converged) {
-      ++unconverged_;
-      last_problem_ = update.report.message;
-    }
-    if (!update.report.warning.empty()) {
-      ROS_WARN_STREAM_THROTTLE(5.0, "cvo_odometry: " << update.report.warning);
-    }
-    cosine = odometry_->registration().cosine(*previous, cloud, update.motion,
-                                              update.report.final_lengthscale);
-  }
-  publish(header, update, cloud, previous ? previous->size() : 0, stats, cosine);
-  if (previous && previous_cloud_pub_.getNumSubscribers() > 0) {
-    std_msgs::Header previous_header = header;
-    previous_header.stamp = ros::Time(update.stamp - update.dt);
+  count(update);
+  publish(header, update, cloud ? &*cloud : nullptr, stats);
+  if (reference) {
+    std_msgs::Header reference_header = header;
+    reference_header.stamp = ros::Time(update.stamp - update.dt);
     previous_cloud_pub_.publish(
-        cloudToMsg(*previous, Eigen::Isometry3f::Identity(), previous_header));
+        cloudToMsg(*reference, Eigen::Isometry3f::Identity(), reference_header));
+  }
+}
+
+void CvoOdometryRos::count(const OdometryUpdate& update) {
+  switch (update.state) {
+    case TrackingState::kRecovered:
+      ++recovered_;
+      break;
+    case TrackingState::kLost:
+      ++lost_;
+      break;
+    case TrackingState::kReset:
+      ++lost_;
+      ++tracking_resets_;
+      break;
+    default:
+      break;
+  }
+  lost_now_ = update.state == TrackingState::kLost || update.state == TrackingState::kReset;
+  if (lost_now_) lost_problem_ = update.problem;
+  if (!update.problem.empty()) {
+    last_problem_ = toString(update.state) + ": " + update.problem;
+    ROS_WARN_STREAM_THROTTLE(
+        2.0, "cvo_odometry: frame " << toString(update.state) << ": " << update.problem);
+  }
+  if (!update.report.warning.empty()) {
+    ++backend_fallbacks_;
+    ROS_WARN_STREAM_THROTTLE(5.0, "cvo_odometry: " << update.report.warning);
   }
 }
 
 void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdate& update,
-                             const LabeledCloud& cloud, std::size_t previous_points,
-                             const FrontendStats& stats, double cosine) {
+                             const LabeledCloud* cloud, const FrontendStats& stats) {
   const Eigen::Isometry3d& base_T_camera = *base_from_camera_;
   const Eigen::Isometry3d pose = base_T_camera * update.pose * base_T_camera.inverse();
   const Eigen::Isometry3d motion = base_T_camera * update.motion * base_T_camera.inverse();
+  const bool trusted = update.problem.empty() || update.state == TrackingState::kRecovered;
 
-  // Motion covariance in the base frame, accumulated along the path (dead reckoning).
+  // Motion covariance in the base frame, accumulated along the path (dead reckoning). A motion
+  // that was guessed (lost frame, reset) is known only to the plausible maxima.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   if (!update.first_frame) {
     Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Zero();
     rotate.topLeftCorner<3, 3>() = rotate.bottomRightCorner<3, 3>() = base_T_camera.rotation();
-    motion_covariance =
-        rotate *
-        registrationCovariance(cloud, update.motion, update.report.final_lengthscale, cosine) *
-        rotate.transpose();
+    const Eigen::Matrix<double, 6, 6> camera_covariance =
+        trusted && cloud ? registrationCovariance(*cloud, update.motion,
+                                                  update.report.final_lengthscale, update.cosine)
+                         : guessedMotionCovariance(params_, update.dt);
+    motion_covariance = rotate * camera_covariance * rotate.transpose();
     pose_covariance_ += motion_covariance;
   }
+
+  cvo_odometry::CvoIndicator indicator;
+  indicator.header.stamp = header.stamp;
+  indicator.header.frame_id = odom_frame_;
+  indicator.first_frame = update.first_frame;
+  indicator.state = toString(update.state);
+  indicator.trusted = trusted;
+  indicator.published = update.has_pose;
+  indicator.lost_frames = static_cast<uint32_t>(update.lost_frames);
+  indicator.attempts = static_cast<uint8_t>(update.attempts);
+  indicator.problem = update.problem;
+  indicator.indicator = update.report.indicator_after;
+  indicator.indicator_before = update.report.indicator_before;
+  indicator.cosine = update.first_frame ? 1.0 : update.cosine;
+  indicator.iterations = update.report.iterations;
+  indicator.initial_lengthscale = update.report.initial_lengthscale;
+  indicator.final_lengthscale = update.report.final_lengthscale;
+  indicator.converged = update.first_frame || update.report.converged;
+  indicator.registration_ms = update.report.time_ms;
+  indicator.frontend_ms = stats.time_ms;
+  indicator.source_points = static_cast<uint32_t>(cloud ? cloud->size() : 0);
+  indicator.target_points = static_cast<uint32_t>(update.reference_points);
+  indicator.backend = update.report.backend;
+  indicator.message = update.first_frame ? "first frame"
+                      : !update.report.warning.empty()
+                          ? update.report.message + "; " + update.report.warning
+                          : update.report.message;
+  indicator_pub_.publish(indicator);
+  if (!update.has_pose) return;  // lost_frame_policy publish_nothing
 
   nav_msgs::Odometry odom;
   odom.header.stamp = header.stamp;
@@ -414,7 +489,7 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   odom.child_frame_id = base_frame_;
   odom.pose.pose = toPoseMsg(pose);
   if (!update.first_frame && update.dt > 0.0) {
-    // The last frame's motion over its interval, in the base frame (child_frame_id).
+    // The motion since the reference frame over its interval, in the base frame.
     const Eigen::Vector3d omega = lie::logSO3(motion.rotation());
     odom.twist.twist.linear.x = motion.translation().x() / update.dt;
     odom.twist.twist.linear.y = motion.translation().y() / update.dt;
@@ -441,32 +516,13 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
     tf_broadcaster_.sendTransform(tf);
   }
 
-  cvo_odometry::CvoIndicator indicator;
-  indicator.header.stamp = header.stamp;
-  indicator.header.frame_id = odom_frame_;
-  indicator.first_frame = update.first_frame;
-  indicator.indicator = update.report.indicator_after;
-  indicator.indicator_before = update.report.indicator_before;
-  indicator.cosine = cosine;
-  indicator.iterations = update.report.iterations;
-  indicator.initial_lengthscale = update.report.initial_lengthscale;
-  indicator.final_lengthscale = update.report.final_lengthscale;
-  indicator.converged = update.first_frame || update.report.converged;
-  indicator.registration_ms = update.report.time_ms;
-  indicator.frontend_ms = stats.time_ms;
-  indicator.source_points = static_cast<uint32_t>(cloud.size());
-  indicator.target_points = static_cast<uint32_t>(previous_points);
-  indicator.backend = update.report.backend;
-  indicator.message = update.first_frame ? "first frame" : update.report.message;
-  indicator_pub_.publish(indicator);
-
   geometry_msgs::PoseStamped stamped;
   stamped.header = odom.header;
   stamped.pose = odom.pose.pose;
   path_.header = odom.header;
   path_.poses.push_back(stamped);
   if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(path_);
-  publishDebugClouds(header, update, cloud);
+  if (cloud) publishDebugClouds(header, update, *cloud);
 }
 
 void CvoOdometryRos::publishDebugClouds(const std_msgs::Header& header,
@@ -492,6 +548,7 @@ void CvoOdometryRos::resetState(const std::string& why) {
   last_stamp_.reset();
   pose_covariance_.setZero();
   path_.poses.clear();
+  lost_now_ = false;
   ++resets_;
 }
 
@@ -511,11 +568,17 @@ void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
   next.semantic_ell = config.semantic_ell, next.semantic_sigma = config.semantic_sigma;
   next.max_iterations = config.max_iterations, next.min_step = config.min_step;
   next.max_step = config.max_step;
+  next.min_cosine = config.min_cosine;
+  next.min_tracking_points = config.min_tracking_points;
+  next.max_linear_speed = config.max_linear_speed;
+  next.max_angular_speed = config.max_angular_speed;
+  next.max_lost_frames = config.max_lost_frames;
   CloudBuilderOptions cloud = cloud_options_;
   cloud.selector.min_points = config.min_points;
   cloud.selector.max_points = config.max_points;
   try {
     next.backend = parseBackendChoice(config.backend);
+    next.lost_frame_policy = parseLostFramePolicy(config.lost_frame_policy);
     next.validate();
     cloud.validate();
   } catch (const std::invalid_argument& e) {
@@ -542,15 +605,27 @@ void CvoOdometryRos::applyPendingConfig() {
     params_ = *pending_params_;
     pending_params_.reset();
     if (new_backend) {
-      odometry_ = std::make_unique<FrameToFrameOdometry>(params_);
-      last_stamp_.reset();
-      ROS_INFO_STREAM("cvo_odometry: backend now " << odometry_->registration().backend().name()
-                                                   << "; odometry restarted");
+      makeOdometry();
+      resetState("backend now " + odometry_->registration().backend().name() +
+                 "; odometry restarted");
     } else {
-      odometry_->registration().setParams(params_);
+      odometry_->setParams(params_);
     }
     ROS_INFO_STREAM("cvo_odometry: parameters updated:\n" << describe(params_, cloud_options_));
   }
+}
+
+void CvoOdometryRos::makeOdometry() {
+  std::unique_ptr<RegistrationBackend> backend = makeBackend(params_.backend, params_.num_threads);
+  if (inject_backend_fault_after_ >= 0) {
+    // Test hook: the backend fails from then on, as a GPU lost mid-run; the CPU takes over.
+    ROS_WARN_STREAM("cvo_odometry: the backend will fail after " << inject_backend_fault_after_
+                                                                 << " evaluations (test hook)");
+    backend = std::make_unique<FailoverBackend>(
+        std::make_unique<FaultInjectionBackend>(std::move(backend), inject_backend_fault_after_),
+        std::make_unique<CpuBackend>(params_.num_threads));
+  }
+  odometry_ = std::make_unique<FrameToFrameOdometry>(params_, std::move(backend));
 }
 
 Eigen::Isometry3d CvoOdometryRos::baseFromCamera(const std::string& camera_frame) {
@@ -571,6 +646,8 @@ void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   std::lock_guard<std::mutex> lock(mutex_);
   if (frames_ == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame processed yet");
+  } else if (lost_now_) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "tracking lost: " + lost_problem_);
   } else if (!last_problem_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, last_problem_);
   } else {
@@ -580,7 +657,10 @@ void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("skipped frames", skipped_);
   const std::size_t handled = frames_ + skipped_;
   status.add("frames not synchronized", arrived_ > handled ? arrived_ - handled : 0);
-  status.add("unconverged registrations", unconverged_);
+  status.add("lost frames", lost_);
+  status.add("recovered frames", recovered_);
+  status.add("tracking restarts", tracking_resets_);
+  status.add("backend fallbacks", backend_fallbacks_);
   status.add("resets", resets_);
   status.add("backend", odometry_->registration().backend().name());
   last_problem_.clear();

@@ -39,6 +39,12 @@ PinholeIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info) 
   PinholeIntrinsics K;
   K.width = static_cast<int>(info.width);
   K.height = static_cast<int>(info.height);
+  const auto finite = [](const auto& values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  if (!finite(info.K) || !finite(info.P) || !finite(info.D)) {
+    throw std::invalid_argument("camera_info has non-finite values in K, P or D");
+  }
   if (info.P[0] > 0.0) {
     K.fx = info.P[0], K.fy = info.P[5], K.cx = info.P[2], K.cy = info.P[6];
   } else if (info.K[0] > 0.0) {

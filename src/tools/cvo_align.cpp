@@ -46,14 +46,19 @@ int main(int argc, char** argv) {
     const auto result =
         registration.align(target, source, Eigen::Isometry3d::Identity(), cli.has("first-frame"));
     const auto& r = result.report;
+    const double cosine =
+        r.final_lengthscale > 0.0
+            ? registration.cosine(target, source, result.transform, r.final_lengthscale)
+            : 0.0;
     std::cout << std::fixed << std::setprecision(6) << "points: target " << target.size()
               << ", source " << source.size() << "\n"
               << "transform (target <- source):\n"
               << result.transform.matrix() << "\n"
               << "iterations " << r.iterations << ", " << (r.converged ? "converged" : r.message)
               << ", lengthscale " << r.initial_lengthscale << " -> " << r.final_lengthscale
-              << ", indicator " << r.indicator_before << " -> " << r.indicator_after << ", "
-              << std::setprecision(2) << r.time_ms << " ms (" << r.backend << ")\n";
+              << ", indicator " << r.indicator_before << " -> " << r.indicator_after << ", cosine "
+              << cosine << ", " << std::setprecision(2) << r.time_ms << " ms (" << r.backend
+              << ")\n";
     return r.converged ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "cvo_align: " << e.what() << "\n" << kUsage;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/frame_to_frame_odometry.hpp"
@@ -64,15 +65,26 @@ int main(int argc, char** argv) {
     cvo::Trajectory trajectory;
     cvo::StageTimer timer;
     const auto start = std::chrono::steady_clock::now();
+    std::map<cvo::TrackingState, int> states;
     for (std::size_t k = first; k <= last; ++k) {
       cvo::FrontendStats stats;
-      cvo::LabeledCloud cloud = input.cloud(k, &stats);
-      timer.add("frontend", stats.time_ms);
-      const cvo::OdometryUpdate update = odometry.process(input.stamps[k], std::move(cloud));
-      trajectory.append(input.stamps[k], update.pose);
-      if (!update.first_frame) {
+      cvo::OdometryUpdate update;
+      const auto frame_start = std::chrono::steady_clock::now();
+      try {
+        cvo::LabeledCloud cloud = input.cloud(k, &stats);
+        timer.add("frontend", stats.time_ms);
+        update = odometry.process(input.stamps[k], std::move(cloud));
+      } catch (const std::invalid_argument& e) {
+        // A frame the front end cannot use (no valid depth, say) is a lost frame, not the end.
+        update = odometry.processLostFrame(input.stamps[k], e.what());
+      }
+      ++states[update.state];
+      if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
+      if (update.attempts > 0) {
         timer.add("registration", update.report.time_ms);
-        timer.add("total", update.report.time_ms + stats.time_ms);
+        timer.add("total", std::chrono::duration<double, std::milli>(
+                               std::chrono::steady_clock::now() - frame_start)
+                               .count());
       }
       const std::size_t done = k - first + 1;
       const double elapsed =
@@ -82,14 +94,24 @@ int main(int argc, char** argv) {
       } else if (!cli.has("quiet")) {
         std::cerr << "frame " << k << ": " << stats.selection.selected << " points (FAST "
                   << stats.selection.fast_threshold << ")";
-        if (!update.first_frame) {
+        if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
-                    << std::fixed << update.report.time_ms << " ms, "
+                    << std::fixed << update.report.time_ms << " ms, cosine " << std::setprecision(3)
+                    << update.cosine << ", "
                     << (update.report.converged ? "converged" : update.report.message);
         }
+        if (update.state != cvo::TrackingState::kTracking) {
+          std::cerr << ", " << cvo::toString(update.state);
+        }
+        if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         std::cerr << "\n";
       }
     }
+    std::cout << "tracking: " << states[cvo::TrackingState::kTracking] << " tracked, "
+              << states[cvo::TrackingState::kRecovered] << " recovered, "
+              << states[cvo::TrackingState::kLost] << " lost, "
+              << states[cvo::TrackingState::kReset] << " resets, "
+              << states[cvo::TrackingState::kFirstFrame] << " first frames\n";
     timer.print(std::cout);
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))

@@ -6,6 +6,7 @@
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/cvo_steps.hpp"
 #include "cvo_odometry/core/failover_backend.hpp"
+#include "cvo_odometry/core/fault_injection_backend.hpp"
 #include "synthetic_scene.hpp"
 
 using cvo::CvoParams;
@@ -290,24 +291,6 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   EXPECT_THROW(CvoRegistration{p}, std::invalid_argument);
 }
 
-namespace {
-
-// A backend that works for `good_calls` evaluations and then fails like a lost GPU would.
-class FailingBackend : public cvo::CpuBackend {
- public:
-  explicit FailingBackend(int good_calls) : cvo::CpuBackend(1), left_(good_calls) {}
-  std::string name() const override { return "flaky"; }
-  cvo::kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override {
-    if (left_-- <= 0) throw std::runtime_error("CUDA moments kernel: an illegal memory access");
-    return cvo::CpuBackend::moments(T, ell);
-  }
-
- private:
-  int left_;
-};
-
-}  // namespace
-
 TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
   CvoParams params = syntheticParams(true);
   const LabeledCloud target = cvo_test::roomScene(2000, 80);
@@ -315,13 +298,14 @@ TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
       pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
   CvoRegistration plain(params, std::make_unique<cvo::CpuBackend>(1));
   CvoRegistration flaky(
-      params, std::make_unique<cvo::FailoverBackend>(std::make_unique<FailingBackend>(5),
+      params, std::make_unique<cvo::FailoverBackend>(std::make_unique<cvo::FaultInjectionBackend>(
+                                                         std::make_unique<cvo::CpuBackend>(1), 5),
                                                      std::make_unique<cvo::CpuBackend>(1)));
   const auto expected = plain.align(target, source, Eigen::Isometry3d::Identity(), true);
   const auto got = flaky.align(target, source, Eigen::Isometry3d::Identity(), true);
   EXPECT_TRUE(got.report.converged);
-  EXPECT_NE(got.report.warning.find("illegal memory access"), std::string::npos);
-  EXPECT_EQ(got.report.backend, "cpu (fallback: flaky failed)");
+  EXPECT_NE(got.report.warning.find("injected backend fault"), std::string::npos);
+  EXPECT_EQ(got.report.backend, "cpu (fallback: cpu (fault injection) failed)");
   // The replayed lists may hold other not-retained candidates, which changes the float lane
   // order of the sums: the same answer to rounding, not to the bit.
   EXPECT_LT((got.transform.matrix() - expected.transform.matrix()).norm(), 1e-6);

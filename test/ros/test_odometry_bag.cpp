@@ -150,5 +150,6 @@ int main(int argc, char** argv) {
   spinner.start();
   const int result = RUN_ALL_TESTS();
   spinner.stop();
+  ros::shutdown();
   return result;
 }

@@ -13,6 +13,13 @@ enum class StepMethod {
 
 enum class BackendChoice { kAuto, kCpu, kCuda };
 
+// What frame-to-frame odometry does with a frame it judges lost (see FrameToFrameOdometry).
+enum class LostFramePolicy {
+  kKeepGuess,       // report the constant-velocity guess, flagged, with a grown covariance
+  kPublishNothing,  // report no pose for the frame
+  kReset            // restart tracking from the frame, holding the last pose
+};
+
 struct CvoParams {
   // Geometric kernel k(x, z) = sigma^2 exp(-|x - z|^2 / (2 ell^2)).
   double ell_init = 0.15;         // lengthscale at the start of a registration (m)
@@ -59,6 +66,19 @@ struct CvoParams {
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;  // 0: all cores
 
+  // Tracking quality, judged per frame by FrameToFrameOdometry. A registration is good when it
+  // converged, the cosine of the two functions at its final lengthscale is >= min_cosine, both
+  // clouds have >= min_tracking_points and its motion is within the speed limits over the
+  // frame interval. A bad one is retried from identity with the first-frame lengthscale; if that
+  // fails too the frame is lost and lost_frame_policy applies. After max_lost_frames lost frames
+  // in a row tracking restarts (as kReset).
+  double min_cosine = 0.3;
+  int min_tracking_points = 300;
+  double max_linear_speed = 5.0;     // m/s
+  double max_angular_speed = 180.0;  // deg/s
+  LostFramePolicy lost_frame_policy = LostFramePolicy::kKeepGuess;
+  int max_lost_frames = 5;
+
   // Throws std::invalid_argument naming the first parameter that makes no sense.
   void validate() const;
   // The largest pair weight: s^2 times s_V^2 of every appearance kernel in use.
@@ -67,7 +87,9 @@ struct CvoParams {
 
 std::string toString(StepMethod method);
 std::string toString(BackendChoice backend);
+std::string toString(LostFramePolicy policy);
 StepMethod parseStepMethod(const std::string& name);
 BackendChoice parseBackendChoice(const std::string& name);
+LostFramePolicy parseLostFramePolicy(const std::string& name);
 
 }  // namespace cvo

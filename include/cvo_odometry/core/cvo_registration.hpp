@@ -38,6 +38,8 @@ class CvoRegistration {
   // The paper's alignment indicator F / sqrt(|X||Z|).
   double indicator(const LabeledCloud& target, const LabeledCloud& source,
                    const Eigen::Isometry3d& T, double ell);
+  // F(X, X) at `ell`: the squared norm of a cloud's function.
+  double selfProduct(const LabeledCloud& cloud, double ell);
   // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1].
   double cosine(const LabeledCloud& target, const LabeledCloud& source, const Eigen::Isometry3d& T,
                 double ell);

@@ -1,10 +1,14 @@
-// Frame-to-frame odometry over CVO: each new cloud is registered to the previous one. The first
-// registration of a sequence starts from identity with the first-frame lengthscale; later ones
-// from the previous motion, scaled to the new frame interval (constant velocity).
+// Frame-to-frame odometry over CVO: each new cloud is registered to the reference, the last
+// frame judged good. The first registration of a sequence starts from identity with the
+// first-frame lengthscale; later ones from the reference's motion scaled to the new interval
+// (constant velocity). Every registration is judged (see tracking_check.hpp); a bad one is
+// retried from identity with the first-frame lengthscale, and a frame that fails both is lost:
+// CvoParams::lost_frame_policy says what its pose is.
 #pragma once
 
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -12,13 +16,32 @@
 
 namespace cvo {
 
+enum class TrackingState {
+  kFirstFrame,  // no reference yet: the frame becomes it, no registration
+  kTracking,    // registered and judged good
+  kRecovered,   // the first registration was bad, the retry good
+  kLost,        // no trusted registration: the pose is the constant-velocity guess
+  kReset        // lost, and tracking restarts from this frame, holding the last pose
+};
+
+std::string toString(TrackingState state);
+
 struct OdometryUpdate {
-  bool first_frame = false;  // the first cloud: no registration, pose = start
+  TrackingState state = TrackingState::kFirstFrame;
+  bool first_frame = false;  // state == kFirstFrame
+  // False for a lost frame under LostFramePolicy::kPublishNothing: report no pose.
+  bool has_pose = true;
   double stamp = 0.0;
-  double dt = 0.0;                                           // seconds since the previous frame
+  double dt = 0.0;                                           // seconds since the reference frame
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();    // start <- current
-  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current
-  RegistrationReport report;
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // reference <- current
+  RegistrationReport report;  // of the registration used (the retry's after a retry)
+  double cosine = 0.0;        // at the result and final lengthscale; 0 without a registration
+  int attempts = 0;           // registrations run for this frame: 0, 1 or 2
+  int lost_frames = 0;        // consecutive lost frames up to and including this one
+  std::string problem;        // why a registration was judged bad (also after a recovery)
+  // Points of the reference the frame was registered to.
+  std::size_t reference_points = 0;
 };
 
 class FrameToFrameOdometry {
@@ -27,21 +50,49 @@ class FrameToFrameOdometry {
                                 std::unique_ptr<RegistrationBackend> backend = nullptr);
 
   // Throws std::invalid_argument if `stamp` is not after the previous frame's (call reset()
-  // first for a new sequence), or for clouds the registration rejects.
+  // first for a new sequence), or for clouds the registration rejects (non-finite points,
+  // missing features). A cloud with too few points is a lost frame, not an error.
   OdometryUpdate process(double stamp, LabeledCloud cloud);
+  // A frame that produced no cloud (e.g. no valid depth): lost, for `why`.
+  OdometryUpdate processLostFrame(double stamp, const std::string& why);
+  // Forgets everything: the next frame starts a new trajectory at identity.
   void reset();
 
+  // New parameters from the next frame on (see CvoRegistration::setParams).
+  void setParams(const CvoParams& params);
+
   CvoRegistration& registration() { return registration_; }
-  bool hasPrevious() const { return previous_.has_value(); }
-  const LabeledCloud* previousCloud() const { return previous_ ? &*previous_ : nullptr; }
+  bool hasReference() const { return reference_.has_value(); }
+  // The cloud the next frame will be registered to, or null.
+  const LabeledCloud* referenceCloud() const { return reference_ ? &*reference_ : nullptr; }
 
  private:
+  struct Attempt {
+    RegistrationResult result;
+    double cosine = 0.0;
+    std::string problems;
+    bool good = false;
+  };
+  Attempt attempt(const LabeledCloud& cloud, const Eigen::Isometry3d& guess, bool first_frame,
+                  double dt);
+  // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
+  double referenceSelfProduct(double ell);
+  void checkStamp(double stamp) const;
+  Eigen::Isometry3d predictedMotion(double dt) const;
+  void accept(OdometryUpdate& update, LabeledCloud cloud);
+  void lose(OdometryUpdate& update, std::optional<LabeledCloud> cloud, const std::string& why);
+
   CvoRegistration registration_;
-  std::optional<LabeledCloud> previous_;
-  double previous_stamp_ = 0.0;
-  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
-  std::optional<Eigen::Isometry3d> last_motion_;
+  std::optional<LabeledCloud> reference_;
+  // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
+  std::optional<std::pair<double, double>> reference_self_, source_self_;
+  double reference_stamp_ = 0.0;
+  Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();
+  std::optional<double> last_stamp_;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();  // the latest estimate
+  std::optional<Eigen::Isometry3d> last_motion_;            // of the last good registration
   double last_dt_ = 0.0;
+  int lost_frames_ = 0;
 };
 
 }  // namespace cvo

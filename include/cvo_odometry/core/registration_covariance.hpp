@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/cvo_params.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
 
 namespace cvo {
@@ -16,5 +17,10 @@ namespace cvo {
 Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
                                                    const Eigen::Isometry3d& target_from_source,
                                                    double lengthscale, double cosine);
+
+// The covariance of a motion that was guessed, not measured (a lost frame): over `dt` seconds
+// the motion is known only to within the plausible maxima, max_linear_speed * dt and
+// max_angular_speed * dt, taken as standard deviations. Same order as above.
+Eigen::Matrix<double, 6, 6> guessedMotionCovariance(const CvoParams& params, double dt);
 
 }  // namespace cvo

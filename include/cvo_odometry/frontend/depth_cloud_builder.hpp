@@ -40,8 +40,9 @@ class DepthCloudBuilder {
 
   // `depth_metres`: CV_32FC1, NaN where invalid, registered to `image` (8-bit BGR or grey).
   // Throws std::invalid_argument naming the problem: empty or mismatched images, intrinsics that
-  // make no sense or do not match the image, a missing or unusable segmentation image, or no
-  // pixel with valid depth.
+  // make no sense or do not match the image, a missing or unusable segmentation image; throws
+  // EmptyFrameError (a std::invalid_argument) when no pixel has valid depth or every selected
+  // one is in an ignored class.
   LabeledCloud build(const cv::Mat& image, const cv::Mat& depth_metres,
                      const PinholeIntrinsics& intrinsics, const cv::Mat& semantics,
                      FrontendStats* stats);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -49,6 +50,8 @@ class CvoOdometryRos {
   // The RGB-D and stereo front ends from cloud_options_ (at start and when the point range
   // changes).
   void makeCloudBuilders();
+  // FrameToFrameOdometry with the backend of params_ (at start and when the backend changes).
+  void makeOdometry();
   void subscribe();
   void onRgbd(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info,
               const sensor_msgs::ImageConstPtr& depth, const sensor_msgs::ImageConstPtr& labels);
@@ -69,11 +72,18 @@ class CvoOdometryRos {
                 const sensor_msgs::ImageConstPtr& right,
                 const sensor_msgs::CameraInfoConstPtr& right_info,
                 const stereo_msgs::DisparityImageConstPtr& disparity);
-  // Registers `cloud` and publishes; `header` is the current frame's.
-  void process(const std_msgs::Header& header, LabeledCloud cloud, const FrontendStats& stats);
+  // Runs the front end: a cloud is processed, an empty frame is a lost frame, inconsistent
+  // input is skipped.
+  void buildAndProcess(const std_msgs::Header& header,
+                       const std::function<LabeledCloud(FrontendStats*)>& build);
+  // Registers `cloud` (or, without one, a lost frame for `why_no_cloud`) and publishes;
+  // `header` is the current frame's.
+  void process(const std_msgs::Header& header, std::optional<LabeledCloud> cloud,
+               const std::string& why_no_cloud, const FrontendStats& stats);
+  void count(const OdometryUpdate& update);
+  // The indicator always; odometry, TF, path and debug clouds when the update has a pose.
   void publish(const std_msgs::Header& header, const OdometryUpdate& update,
-               const LabeledCloud& cloud, std::size_t previous_points, const FrontendStats& stats,
-               double cosine);
+               const LabeledCloud* cloud, const FrontendStats& stats);
   void publishDebugClouds(const std_msgs::Header& header, const OdometryUpdate& update,
                           const LabeledCloud& cloud);
   void skipFrame(const std::string& why);
@@ -105,13 +115,20 @@ class CvoOdometryRos {
   Eigen::Matrix<double, 6, 6> pose_covariance_ = Eigen::Matrix<double, 6, 6>::Zero();
   nav_msgs::Path path_;
 
-  std::size_t frames_ = 0, skipped_ = 0, unconverged_ = 0, resets_ = 0;
+  int inject_backend_fault_after_ = -1;  // test hook, see makeOdometry
+
+  std::size_t frames_ = 0, skipped_ = 0, resets_ = 0;
+  std::size_t lost_ = 0, recovered_ = 0, tracking_resets_ = 0, backend_fallbacks_ = 0;
+  bool lost_now_ = false;  // the latest frame was lost
+  std::string lost_problem_;
   std::atomic<std::size_t> arrived_{0};  // images of the main stream, before synchronization
   std::string last_problem_;
 
   image_transport::ImageTransport it_;
-  std::shared_ptr<void> sync_;  // the message_filters synchronizer of the chosen mode
+  // Members are destroyed in reverse order: the synchronizer before the filters it is
+  // connected to, the reconfigure server before its mutex.
   std::vector<std::shared_ptr<void>> filters_;
+  std::shared_ptr<void> sync_;  // the message_filters synchronizer of the chosen mode
   std::mutex info_mutex_;
   sensor_msgs::CameraInfoConstPtr rgb_info_;  // latest rgb/camera_info
   ros::Subscriber rgb_info_sub_;
@@ -121,8 +138,8 @@ class CvoOdometryRos {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
-  std::unique_ptr<dynamic_reconfigure::Server<CvoOdometryConfig>> reconfigure_;
   boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<CvoOdometryConfig>> reconfigure_;
   diagnostic_updater::Updater diagnostics_;
   std::unique_ptr<diagnostic_updater::HeaderlessTopicDiagnostic> rate_diagnostic_;
   double min_rate_ = 1.0, max_rate_ = 100.0;

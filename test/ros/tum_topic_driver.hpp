@@ -1,0 +1,178 @@
+// Test fixture for rostest nodes that drive the nodelet with real TUM frames published on its
+// RGB-D topics (camera namespace) and collect what it publishes: indicators, odometry, the
+// debug cloud's fields and diagnostics.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <cv_bridge/cv_bridge.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include "cvo_odometry/CvoIndicator.h"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+
+namespace cvo_test {
+
+class TumTopicDriver : public testing::Test {
+ protected:
+  // Loads the fixture's frames `frames`, connects to the nodelet (segmentation topic too when
+  // `segmentation`), and publishes a camera_info unless told not to.
+  void connect(const std::vector<std::size_t>& frames, bool segmentation, bool camera_info = true) {
+    const cvo::TumSequence sequence(std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz");
+    for (std::size_t k : frames) {
+      cv::Mat image, depth, metres;
+      sequence.load(k, &image, &depth);
+      depth.convertTo(metres, CV_32F, 1.0 / 5000.0);
+      images_[k] = image;
+      depths_[k] = metres;
+    }
+    rgb_pub_ = nh_.advertise<sensor_msgs::Image>("rgb/image_rect_color", 5);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("rgb/camera_info", 5, true);
+    depth_pub_ = nh_.advertise<sensor_msgs::Image>("depth_registered/image_rect", 5);
+    if (segmentation) labels_pub_ = nh_.advertise<sensor_msgs::Image>("segmentation/image", 5);
+    indicator_sub_ = nh_.subscribe<cvo_odometry::CvoIndicator>(
+        "indicator", 50, [this](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          indicators_.push_back(*msg);
+        });
+    odom_sub_ = nh_.subscribe<nav_msgs::Odometry>("odom", 50,
+                                                  [this](const nav_msgs::Odometry::ConstPtr& msg) {
+                                                    std::lock_guard<std::mutex> lock(mutex_);
+                                                    odoms_.push_back(*msg);
+                                                  });
+    cloud_sub_ = nh_.subscribe<sensor_msgs::PointCloud2>(
+        "cloud/current", 2, [this](const sensor_msgs::PointCloud2::ConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          cloud_fields_.clear();
+          for (const auto& f : msg->fields)
+            cloud_fields_.push_back(f.name);
+        });
+    diagnostics_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics", 10, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          for (const auto& status : msg->status) {
+            if (status.name.find("odometry") == std::string::npos) continue;
+            for (const auto& kv : status.values)
+              diagnostics_[kv.key] = kv.value;
+          }
+        });
+    if (camera_info) publishInfo(cameraInfo());
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+    while ((depth_pub_.getNumSubscribers() == 0 || rgb_pub_.getNumSubscribers() == 0 ||
+            (segmentation && labels_pub_.getNumSubscribers() == 0) ||
+            indicator_sub_.getNumPublishers() == 0 || cloud_sub_.getNumPublishers() == 0) &&
+           ros::WallTime::now() < deadline) {
+      ros::WallDuration(0.1).sleep();
+    }
+    ros::WallDuration(1.0).sleep();  // the nodelet's camera_info subscriber too
+  }
+
+  static sensor_msgs::CameraInfo cameraInfo() {
+    sensor_msgs::CameraInfo info;
+    info.width = 640, info.height = 480;
+    info.K = {517.3, 0, 318.6, 0, 516.5, 255.3, 0, 0, 1};
+    info.P = {517.3, 0, 318.6, 0, 0, 516.5, 255.3, 0, 0, 0, 1, 0};
+    info.header.frame_id = "camera_rgb_optical_frame";
+    return info;
+  }
+
+  void publishInfo(const sensor_msgs::CameraInfo& info) {
+    info_pub_.publish(info);
+    ros::WallDuration(0.5).sleep();  // latched, but the nodelet must have it before the frame
+  }
+
+  static std_msgs::Header header(double stamp) {
+    std_msgs::Header h;
+    h.stamp = ros::Time(stamp);
+    h.frame_id = "camera_rgb_optical_frame";
+    return h;
+  }
+
+  sensor_msgs::ImagePtr colour(std::size_t k, double stamp) const {
+    return cv_bridge::CvImage(header(stamp), sensor_msgs::image_encodings::BGR8, images_.at(k))
+        .toImageMsg();
+  }
+  sensor_msgs::ImagePtr depth(std::size_t k, double stamp) const {
+    return cv_bridge::CvImage(header(stamp), sensor_msgs::image_encodings::TYPE_32FC1,
+                              depths_.at(k))
+        .toImageMsg();
+  }
+
+  // Publishes a colour and a depth image (and a one-class label image when segmentation is on).
+  void publish(const sensor_msgs::ImagePtr& rgb, const sensor_msgs::ImagePtr& depth_image) {
+    rgb_pub_.publish(rgb);
+    if (labels_pub_) {
+      const cv::Mat labels(480, 640, CV_8UC1, cv::Scalar(1));
+      labels_pub_.publish(
+          cv_bridge::CvImage(rgb->header, sensor_msgs::image_encodings::MONO8, labels)
+              .toImageMsg());
+    }
+    depth_pub_.publish(depth_image);
+  }
+  void publish(std::size_t k, double stamp) { publish(colour(k, stamp), depth(k, stamp)); }
+
+  // Waits until `count` indicators arrived (or `timeout_s` passed); returns how many there are.
+  std::size_t waitFor(std::size_t count, double timeout_s = 20.0) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
+    while (ros::WallTime::now() < deadline) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (indicators_.size() >= count) return indicators_.size();
+      }
+      ros::WallDuration(0.05).sleep();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    return indicators_.size();
+  }
+
+  cvo_odometry::CvoIndicator indicator(std::size_t k) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return indicators_.at(k);
+  }
+  std::vector<nav_msgs::Odometry> odometry() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return odoms_;
+  }
+  std::vector<std::string> cloudFields() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return cloud_fields_;
+  }
+  // The latest value of a key of the nodelet's diagnostics ("" if not seen), waiting up to
+  // `timeout_s` for one that satisfies `ready`.
+  template <class Ready>
+  std::string diagnostic(const std::string& key, Ready ready, double timeout_s = 5.0) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
+    std::string value;
+    do {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const auto it = diagnostics_.find(key);
+        value = it == diagnostics_.end() ? "" : it->second;
+      }
+      if (!value.empty() && ready(value)) break;
+      ros::WallDuration(0.1).sleep();
+    } while (ros::WallTime::now() < deadline);
+    return value;
+  }
+
+  ros::NodeHandle nh_;
+  std::map<std::size_t, cv::Mat> images_, depths_;
+  ros::Publisher rgb_pub_, info_pub_, depth_pub_, labels_pub_;
+  ros::Subscriber indicator_sub_, odom_sub_, cloud_sub_, diagnostics_sub_;
+  std::mutex mutex_;
+  std::vector<cvo_odometry::CvoIndicator> indicators_;
+  std::vector<nav_msgs::Odometry> odoms_;
+  std::vector<std::string> cloud_fields_;
+  std::map<std::string, std::string> diagnostics_;
+};
+
+}  // namespace cvo_test
