@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cvo_odometry needs; quick and quiet when they are all present.
-# Usage: scripts/install_deps.sh [core|full|peers|viz]
+# Usage: scripts/install_deps.sh [core|full|peers|viz|sanitize]
 #   core: CMake, compiler, Eigen, GoogleTest; full: + OpenCV and ROS; peers: + PCL, Open3D,
-#   OpenCV contrib; viz: full + rviz
+#   OpenCV contrib; viz: full + rviz; sanitize: core + OpenCV + clang and its runtimes
 set -euo pipefail
 profile=${1:-full}
 
@@ -19,6 +19,8 @@ full=("${core[@]}" libopencv-dev clang-format
   libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev)
 # rviz only for watching (scripts/demo.sh --rviz): large, not needed by the tests.
 viz=("${full[@]}" rviz)
+# The checking build (scripts/test_sanitizers.sh): clang with its sanitizer and libFuzzer runtimes.
+sanitize=("${core[@]}" libopencv-dev clang libclang-rt-14-dev)
 # Peers for bench/peer_table.sh only (large: PCL, Open3D, OpenCV contrib).
 peers=(libopencv-contrib-dev libpcl-dev python3-open3d python3-numpy)
 
@@ -27,7 +29,8 @@ case "$profile" in
   full) wanted=("${full[@]}") ;;
   peers) wanted=("${full[@]}" "${peers[@]}") ;;
   viz) wanted=("${viz[@]}") ;;
-  *) echo "usage: $0 [core|full|peers|viz]" >&2; exit 2 ;;
+  sanitize) wanted=("${sanitize[@]}") ;;
+  *) echo "usage: $0 [core|full|peers|viz|sanitize]" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 
 #include "cvo_odometry/core/format_error.hpp"
@@ -27,7 +28,9 @@ double toNumber(const std::string& key, const std::string& value) {
 
 int toInt(const std::string& key, const std::string& value) {
   const double v = toNumber(key, value);
-  if (v != static_cast<int>(v)) {
+  // Range first: converting a double outside int's range is undefined.
+  if (!(v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max()) ||
+      v != static_cast<int>(v)) {
     throw std::invalid_argument("'" + key + "' expects an integer, got '" + value + "'");
   }
   return static_cast<int>(v);
@@ -54,19 +57,24 @@ void setFrontendParam(CloudBuilderOptions& options, const std::string& key,
   }
 }
 
-void loadFrontendParams(const std::string& path, CloudBuilderOptions* options) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open parameter file '" + path + "'");
+void parseFrontendParams(std::istream& in, const std::string& source_name,
+                         CloudBuilderOptions* options) {
   const auto cvo_keys = cvoParamNames();
-  parseKeyValueLines(in, path, [&](const std::string& key, const std::string& value) {
+  parseKeyValueLines(in, source_name, [&](const std::string& key, const std::string& value) {
     if (std::find(cvo_keys.begin(), cvo_keys.end(), key) == cvo_keys.end())
       setFrontendParam(*options, key, value);
   });
   try {
     options->validate();
   } catch (const std::invalid_argument& e) {
-    throw FormatError(path + ": " + e.what());
+    throw FormatError(source_name + ": " + e.what());
   }
+}
+
+void loadFrontendParams(const std::string& path, CloudBuilderOptions* options) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open parameter file '" + path + "'");
+  parseFrontendParams(in, path, options);
 }
 
 }  // namespace cvo

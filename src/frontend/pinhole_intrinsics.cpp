@@ -21,6 +21,14 @@ void PinholeIntrinsics::validate() const {
     fail("principal point (" + std::to_string(cx) + ", " + std::to_string(cy) +
          ") is far outside the " + std::to_string(width) + "x" + std::to_string(height) + " image");
   }
+  // The coefficient counts OpenCV's distortion models have (plumb_bob 5, rational 8, ...).
+  const std::size_t n = distortion.size();
+  if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
+    fail(std::to_string(n) + " distortion coefficients (expected 0, 4, 5, 8, 12 or 14)");
+  }
+  for (double d : distortion) {
+    if (!std::isfinite(d)) fail("a distortion coefficient is not finite");
+  }
 }
 
 }  // namespace cvo

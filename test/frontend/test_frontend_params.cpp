@@ -42,6 +42,9 @@ TEST(FrontendParams, BadValuesNameFileAndLine) {
   }
   std::ofstream(path) << "point_selector: sift\n";
   EXPECT_THROW(cvo::loadFrontendParams(path, &options), cvo::FormatError);
+  // Found by fuzz_params: a value beyond int's range was converted (undefined behaviour).
+  std::ofstream(path) << "min_points: 1e40\n";
+  EXPECT_THROW(cvo::loadFrontendParams(path, &options), cvo::FormatError);
   std::ofstream(path) << "min_points: 5000\nmax_points: 100\n";
   EXPECT_THROW(cvo::loadFrontendParams(path, &options), std::exception);
   std::remove(path.c_str());

@@ -188,6 +188,21 @@ TEST(RgbdFrontend, BadInputGetsAClearError) {
   cvo::PinholeIntrinsics nan_focal = K;
   nan_focal.fx = std::numeric_limits<double>::quiet_NaN();
   expectError([&] { builder.build({f.image, f.depth, nan_focal, cv::Mat()}); }, "focal");
+  // Found by fuzz_frontend: OpenCV asserts on coefficient counts no model has.
+  cvo::PinholeIntrinsics seven = cvo::tumIntrinsics("fr1");
+  seven.distortion.resize(7, 0.01);
+  expectError(
+      [&] {
+        builder.build({f.image, f.depth, seven, cv::Mat()});
+      },
+      "7 distortion coefficients");
+  cvo::PinholeIntrinsics nan_distortion = cvo::tumIntrinsics("fr1");
+  nan_distortion.distortion[0] = std::numeric_limits<double>::quiet_NaN();
+  expectError(
+      [&] {
+        builder.build({f.image, f.depth, nan_distortion, cv::Mat()});
+      },
+      "distortion coefficient is not finite");
   cvo::PinholeIntrinsics other_size = K;
   other_size.width = 1280;
   expectError(

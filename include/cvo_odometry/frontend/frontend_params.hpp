@@ -3,6 +3,7 @@
 // which the CVO preset reader skips.
 #pragma once
 
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,10 @@ namespace cvo {
 void setFrontendParam(CloudBuilderOptions& options, const std::string& key,
                       const std::string& value);
 
+// Applies the front-end keys of preset text (CVO keys skipped) and validates; FormatError names
+// `source_name` and the line of a bad value.
+void parseFrontendParams(std::istream& in, const std::string& source_name,
+                         CloudBuilderOptions* options);
 // Applies the front-end keys of a preset file (CVO keys skipped) and validates; FormatError
 // names the file and line of a bad value.
 void loadFrontendParams(const std::string& path, CloudBuilderOptions* options);

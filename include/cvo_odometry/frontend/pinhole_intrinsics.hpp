@@ -13,7 +13,8 @@ struct PinholeIntrinsics {
   std::vector<double> distortion;
 
   // Throws std::invalid_argument naming what makes no sense (non-positive or non-finite focal
-  // length, principal point far outside the image, zero size).
+  // length, principal point far outside the image, zero size, a distortion coefficient count
+  // no model has, non-finite coefficients).
   void validate() const;
 };
 
