@@ -125,17 +125,8 @@ CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 CvoOdometryRos::~CvoOdometryRos() {
   if (trajectory_file_.empty()) return;
-  Trajectory trajectory;
-  for (const auto& pose : path_.poses) {
-    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
-    p.translation() << pose.pose.position.x, pose.pose.position.y, pose.pose.position.z;
-    p.linear() = Eigen::Quaterniond(pose.pose.orientation.w, pose.pose.orientation.x,
-                                    pose.pose.orientation.y, pose.pose.orientation.z)
-                     .toRotationMatrix();
-    trajectory.append(pose.header.stamp.toSec(), p);
-  }
   try {
-    writeTrajectory(trajectory_file_, trajectory, TrajectoryFormat::kTum);
+    writeTrajectory(trajectory_file_, trajectory_, TrajectoryFormat::kTum);
   } catch (const std::exception& e) {
     ROS_ERROR_STREAM("cvo_odometry: " << e.what());
   }
@@ -193,6 +184,8 @@ void CvoOdometryRos::loadParameters() {
   pnh_.param("publish_tf", publish_tf_, publish_tf_);
   pnh_.param("depth_units_per_metre", depth_units_per_metre_, depth_units_per_metre_);
   pnh_.param<std::string>("trajectory_file", trajectory_file_, "");
+  pnh_.param("max_path_poses", max_path_poses_, max_path_poses_);
+  if (max_path_poses_ < 1) throw std::invalid_argument("max_path_poses must be >= 1");
   pnh_.param("inject_backend_fault_after", inject_backend_fault_after_, -1);
   pnh_.param("expected_rate_min", min_rate_, min_rate_);
   pnh_.param("expected_rate_max", max_rate_, max_rate_);
@@ -521,6 +514,12 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   stamped.pose = odom.pose.pose;
   path_.header = odom.header;
   path_.poses.push_back(stamped);
+  // Bounded: a long run must not grow memory or the message without limit.
+  if (path_.poses.size() > static_cast<std::size_t>(max_path_poses_)) {
+    path_.poses.erase(path_.poses.begin(),
+                      path_.poses.end() - static_cast<std::ptrdiff_t>(max_path_poses_));
+  }
+  if (!trajectory_file_.empty()) trajectory_.append(header.stamp.toSec(), pose);
   if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(path_);
   if (cloud) publishDebugClouds(header, update, *cloud);
 }
@@ -548,6 +547,7 @@ void CvoOdometryRos::resetState(const std::string& why) {
   last_stamp_.reset();
   pose_covariance_.setZero();
   path_.poses.clear();
+  trajectory_ = Trajectory();
   lost_now_ = false;
   ++resets_;
 }

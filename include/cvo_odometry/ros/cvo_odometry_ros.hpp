@@ -29,6 +29,7 @@
 
 #include "cvo_odometry/CvoOdometryConfig.h"
 #include "cvo_odometry/core/frame_to_frame_odometry.hpp"
+#include "cvo_odometry/core/trajectory.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 
@@ -101,6 +102,8 @@ class CvoOdometryRos {
   bool publish_tf_ = true;
   double depth_units_per_metre_ = 1000.0;
   std::string trajectory_file_;
+  Trajectory trajectory_;       // kept only when trajectory_file_ is set, written at shutdown
+  int max_path_poses_ = 10000;  // the path topic keeps the latest poses
 
   std::mutex mutex_;  // one frame at a time; guards state below and the pending config
   CvoParams params_;
