@@ -91,24 +91,9 @@ double FrameToFrameOdometry::referenceSelfProduct(double ell) {
 OdometryUpdate FrameToFrameOdometry::process(double stamp, LabeledCloud cloud) {
   checkStamp(stamp);
   source_self_.reset();
+  if (!reference_) return startFrom(stamp, std::move(cloud), "");
   OdometryUpdate update;
   update.stamp = stamp;
-  if (!reference_) {
-    update.state = TrackingState::kFirstFrame;
-    update.first_frame = true;
-    update.pose = pose_;
-    if (cloud.size() < static_cast<std::size_t>(registration_.params().min_tracking_points)) {
-      // Not worth tracking against: wait for a better first frame, holding the pose.
-      update.problem = "too few points for a first frame (" + std::to_string(cloud.size()) + ")";
-    } else {
-      reference_ = std::move(cloud);
-      reference_self_.reset();
-      reference_stamp_ = stamp;
-      reference_pose_ = pose_;
-    }
-    last_stamp_ = stamp;
-    return update;
-  }
   update.dt = stamp - reference_stamp_;
   update.reference_points = reference_->size();
   const TrackingCheck counts =
@@ -148,19 +133,34 @@ OdometryUpdate FrameToFrameOdometry::process(double stamp, LabeledCloud cloud) {
 
 OdometryUpdate FrameToFrameOdometry::processLostFrame(double stamp, const std::string& why) {
   checkStamp(stamp);
+  if (!reference_) return startFrom(stamp, std::nullopt, why);
   OdometryUpdate update;
   update.stamp = stamp;
-  if (!reference_) {
-    update.state = TrackingState::kFirstFrame;
-    update.first_frame = true;
-    update.pose = pose_;
-    update.problem = why;
-    last_stamp_ = stamp;
-    return update;
-  }
   update.dt = stamp - reference_stamp_;
   update.reference_points = reference_->size();
   lose(update, std::nullopt, why);
+  return update;
+}
+
+OdometryUpdate FrameToFrameOdometry::startFrom(double stamp, std::optional<LabeledCloud> cloud,
+                                               const std::string& why) {
+  OdometryUpdate update;
+  update.stamp = stamp;
+  update.state = TrackingState::kFirstFrame;
+  update.first_frame = true;
+  update.pose = pose_;
+  update.problem = why;
+  const auto minimum = static_cast<std::size_t>(registration_.params().min_tracking_points);
+  if (cloud && cloud->size() < minimum) {
+    // Not worth tracking against: wait for a better first frame, holding the pose.
+    update.problem = "too few points for a first frame (" + std::to_string(cloud->size()) + ")";
+  } else if (cloud) {
+    reference_ = std::move(*cloud);
+    reference_self_.reset();
+    reference_stamp_ = stamp;
+    reference_pose_ = pose_;
+  }
+  last_stamp_ = stamp;
   return update;
 }
 

@@ -16,6 +16,7 @@
 #include "cvo_odometry/frontend/frontend_params.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+#include "kitti_frames.hpp"
 
 namespace {
 
@@ -189,13 +190,7 @@ TEST(StereoFrontend, StereoCloudsRegisterToGroundTruth) {
   cvo::loadFrontendParams(std::string(CVO_SOURCE_DIR) + "/config/kitti_stereo.yaml",
                           &options.cloud);
   cvo::StereoCloudBuilder builder(options);
-  auto cloud = [&](std::size_t k) {
-    cvo::StereoFrame f;
-    sequence.load(k, &f.left, &f.right, nullptr);
-    f.intrinsics = sequence.calibration().left;
-    f.baseline = sequence.calibration().baseline;
-    return builder.build(f);
-  };
+  auto cloud = [&](std::size_t k) { return cvo_test::kittiCloud(sequence, builder, k); };
   const auto target = cloud(0), source = cloud(1);
   const auto gt = cvo::readKittiTrajectory(kKitti + "/poses.txt");
   const Eigen::Isometry3d truth = gt[0].pose.inverse() * gt[1].pose;

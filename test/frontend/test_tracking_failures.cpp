@@ -18,6 +18,7 @@
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
+#include "kitti_frames.hpp"
 
 namespace {
 
@@ -150,13 +151,7 @@ TEST(TrackingFailures, StereoFramesWithoutOverlapAreFlagged) {
   cvo::StereoFrontendOptions options = cvo::kittiStereoFrontendOptions();
   cvo::loadFrontendParams(kConfig + "kitti_stereo.yaml", &options.cloud);
   cvo::StereoCloudBuilder builder(options);
-  auto kitti06 = [&](std::size_t k) {
-    cvo::StereoFrame f;
-    sequence.load(k, &f.left, &f.right, nullptr);
-    f.intrinsics = sequence.calibration().left;
-    f.baseline = sequence.calibration().baseline;
-    return builder.build(f);
-  };
+  auto kitti06 = [&](std::size_t k) { return cvo_test::kittiCloud(sequence, builder, k); };
   cvo::StereoFrame other;
   other.left = cv::imread(kData + "/kitti_stereo_pair/left.png", cv::IMREAD_GRAYSCALE);
   other.right = cv::imread(kData + "/kitti_stereo_pair/right.png", cv::IMREAD_GRAYSCALE);

@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "rostest_main.hpp"
 #include "tum_topic_driver.hpp"
 
 namespace {
@@ -130,12 +131,5 @@ TEST_F(BadInput, MalformedInputIsSkippedFailuresAreFlaggedAndTrackingResumes) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_bad_input");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  return cvo_test::runRosTests(argc, argv, "test_bad_input");
 }

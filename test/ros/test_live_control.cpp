@@ -7,6 +7,7 @@
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <std_srvs/Empty.h>
 
+#include "rostest_main.hpp"
 #include "tum_topic_driver.hpp"
 
 namespace {
@@ -76,12 +77,5 @@ TEST_F(LiveControl, ReconfigureMalformedFramesTimeJumpAndReset) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_live_control");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  return cvo_test::runRosTests(argc, argv, "test_live_control");
 }

@@ -16,6 +16,7 @@
 #include "cvo_odometry/CvoIndicator.h"
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "rostest_main.hpp"
 
 namespace {
 
@@ -144,12 +145,5 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_odometry_bag");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
+  return cvo_test::runRosTests(argc, argv, "test_odometry_bag");
 }

@@ -78,6 +78,8 @@ class FrameToFrameOdometry {
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
   double referenceSelfProduct(double ell);
   void checkStamp(double stamp) const;
+  // A frame without a reference: it becomes the reference (with enough points); the pose holds.
+  OdometryUpdate startFrom(double stamp, std::optional<LabeledCloud> cloud, const std::string& why);
   Eigen::Isometry3d predictedMotion(double dt) const;
   void accept(OdometryUpdate& update, LabeledCloud cloud);
   void lose(OdometryUpdate& update, std::optional<LabeledCloud> cloud, const std::string& why);
