@@ -147,21 +147,28 @@ OdometryUpdate FrameToFrameOdometry::startFrom(double stamp, std::optional<Label
   OdometryUpdate update;
   update.stamp = stamp;
   update.state = TrackingState::kFirstFrame;
-  update.first_frame = true;
   update.pose = pose_;
   update.problem = why;
   const auto minimum = static_cast<std::size_t>(registration_.params().min_tracking_points);
   if (cloud && cloud->size() < minimum) {
     // Not worth tracking against: wait for a better first frame, holding the pose.
     update.problem = "too few points for a first frame (" + std::to_string(cloud->size()) + ")";
-  } else if (cloud) {
-    reference_ = std::move(*cloud);
-    reference_self_.reset();
-    reference_stamp_ = stamp;
-    reference_pose_ = pose_;
   }
+  setReference(std::move(cloud), stamp);
   last_stamp_ = stamp;
   return update;
+}
+
+void FrameToFrameOdometry::setReference(std::optional<LabeledCloud> cloud, double stamp) {
+  reference_.reset();
+  reference_self_.reset();
+  if (cloud &&
+      cloud->size() >= static_cast<std::size_t>(registration_.params().min_tracking_points)) {
+    reference_ = std::move(*cloud);
+    reference_self_ = source_self_;  // F(Z, Z) of this cloud, if its registration computed it
+  }
+  reference_stamp_ = stamp;
+  reference_pose_ = pose_;
 }
 
 void FrameToFrameOdometry::accept(OdometryUpdate& update, LabeledCloud cloud) {
@@ -169,10 +176,7 @@ void FrameToFrameOdometry::accept(OdometryUpdate& update, LabeledCloud cloud) {
   update.pose = pose_;
   last_motion_ = update.motion;
   last_dt_ = update.dt;
-  reference_ = std::move(cloud);
-  reference_self_ = source_self_;
-  reference_stamp_ = update.stamp;
-  reference_pose_ = pose_;
+  setReference(std::move(cloud), update.stamp);
   last_stamp_ = update.stamp;
   lost_frames_ = 0;
 }
@@ -191,14 +195,7 @@ void FrameToFrameOdometry::lose(OdometryUpdate& update, std::optional<LabeledClo
     update.state = TrackingState::kReset;
     update.pose = pose_;
     update.has_pose = params.lost_frame_policy != LostFramePolicy::kPublishNothing;
-    reference_.reset();
-    reference_self_.reset();
-    if (cloud && cloud->size() >= static_cast<std::size_t>(params.min_tracking_points)) {
-      reference_ = std::move(*cloud);
-      reference_self_ = source_self_;
-    }
-    reference_stamp_ = update.stamp;
-    reference_pose_ = pose_;
+    setReference(std::move(cloud), update.stamp);
     last_motion_.reset();
     lost_frames_ = 0;
     return;

@@ -431,12 +431,12 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   const Eigen::Isometry3d& base_T_camera = *base_from_camera_;
   const Eigen::Isometry3d pose = base_T_camera * update.pose * base_T_camera.inverse();
   const Eigen::Isometry3d motion = base_T_camera * update.motion * base_T_camera.inverse();
-  const bool trusted = update.problem.empty() || update.state == TrackingState::kRecovered;
+  const bool trusted = update.trusted();
 
   // Motion covariance in the base frame, accumulated along the path (dead reckoning). A motion
   // that was guessed (lost frame, reset) is known only to the plausible maxima.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  if (!update.first_frame) {
+  if (!update.firstFrame()) {
     Eigen::Matrix<double, 6, 6> rotate = Eigen::Matrix<double, 6, 6>::Zero();
     rotate.topLeftCorner<3, 3>() = rotate.bottomRightCorner<3, 3>() = base_T_camera.rotation();
     const Eigen::Matrix<double, 6, 6> camera_covariance =
@@ -450,7 +450,7 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   cvo_odometry::CvoIndicator indicator;
   indicator.header.stamp = header.stamp;
   indicator.header.frame_id = odom_frame_;
-  indicator.first_frame = update.first_frame;
+  indicator.first_frame = update.firstFrame();
   indicator.state = toString(update.state);
   indicator.trusted = trusted;
   indicator.published = update.has_pose;
@@ -459,17 +459,17 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   indicator.problem = update.problem;
   indicator.indicator = update.report.indicator_after;
   indicator.indicator_before = update.report.indicator_before;
-  indicator.cosine = update.first_frame ? 1.0 : update.cosine;
+  indicator.cosine = update.firstFrame() ? 1.0 : update.cosine;
   indicator.iterations = update.report.iterations;
   indicator.initial_lengthscale = update.report.initial_lengthscale;
   indicator.final_lengthscale = update.report.final_lengthscale;
-  indicator.converged = update.first_frame || update.report.converged;
+  indicator.converged = update.firstFrame() || update.report.converged;
   indicator.registration_ms = update.report.time_ms;
   indicator.frontend_ms = stats.time_ms;
   indicator.source_points = static_cast<uint32_t>(cloud ? cloud->size() : 0);
   indicator.target_points = static_cast<uint32_t>(update.reference_points);
   indicator.backend = update.report.backend;
-  indicator.message = update.first_frame ? "first frame"
+  indicator.message = update.firstFrame() ? "first frame"
                       : !update.report.warning.empty()
                           ? update.report.message + "; " + update.report.warning
                           : update.report.message;
@@ -481,7 +481,7 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   odom.header.frame_id = odom_frame_;
   odom.child_frame_id = base_frame_;
   odom.pose.pose = toPoseMsg(pose);
-  if (!update.first_frame && update.dt > 0.0) {
+  if (!update.firstFrame() && update.dt > 0.0) {
     // The motion since the reference frame over its interval, in the base frame.
     const Eigen::Vector3d omega = lie::logSO3(motion.rotation());
     odom.twist.twist.linear.x = motion.translation().x() / update.dt;
@@ -530,7 +530,7 @@ void CvoOdometryRos::publishDebugClouds(const std_msgs::Header& header,
     current_cloud_pub_.publish(cloudToMsg(cloud, Eigen::Isometry3f::Identity(), header));
   }
   // The current cloud moved into the previous camera frame: it should overlay cloud/previous.
-  if (!update.first_frame && aligned_cloud_pub_.getNumSubscribers() > 0) {
+  if (!update.firstFrame() && aligned_cloud_pub_.getNumSubscribers() > 0) {
     aligned_cloud_pub_.publish(cloudToMsg(cloud, update.motion.cast<float>(), header));
   }
 }

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
-#include <map>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/frame_to_frame_odometry.hpp"
@@ -13,6 +12,7 @@
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/stage_timer.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
+#include "cvo_odometry/tools/tracking_tally.hpp"
 #include "cvo_odometry/tools/trajectory_plot.hpp"
 
 namespace {
@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     cvo::Trajectory trajectory;
     cvo::StageTimer timer;
     const auto start = std::chrono::steady_clock::now();
-    std::map<cvo::TrackingState, int> states;
+    cvo::TrackingTally tally;
     for (std::size_t k = first; k <= last; ++k) {
       cvo::FrontendStats stats;
       cvo::OdometryUpdate update;
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
         // A frame the front end cannot use (no valid depth, say) is a lost frame, not the end.
         update = odometry.processLostFrame(input.stamps[k], e.what());
       }
-      ++states[update.state];
+      tally.add(update.state);
       if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
       if (update.attempts > 0) {
         timer.add("registration", update.report.time_ms);
@@ -107,11 +107,7 @@ int main(int argc, char** argv) {
         std::cerr << "\n";
       }
     }
-    std::cout << "tracking: " << states[cvo::TrackingState::kTracking] << " tracked, "
-              << states[cvo::TrackingState::kRecovered] << " recovered, "
-              << states[cvo::TrackingState::kLost] << " lost, "
-              << states[cvo::TrackingState::kReset] << " resets, "
-              << states[cvo::TrackingState::kFirstFrame] << " first frames\n";
+    tally.print(std::cout);
     timer.print(std::cout);
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))

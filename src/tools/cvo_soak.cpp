@@ -9,12 +9,12 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <map>
 #include <vector>
 
 #include "cvo_odometry/core/frame_to_frame_odometry.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
+#include "cvo_odometry/tools/tracking_tally.hpp"
 
 namespace {
 
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     const std::size_t n = input.stamps.size();
     const double interval = (input.stamps.back() - input.stamps.front()) / (n - 1);
     std::vector<double> ms(frames), resident(frames);
-    std::map<cvo::TrackingState, std::size_t> states;
+    cvo::TrackingTally tally;
     for (std::size_t k = 0; k < frames; ++k) {
       const std::size_t index = pingPong(k, n);
       const auto start = std::chrono::steady_clock::now();
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       ms[k] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                   .count();
       resident[k] = residentMiB();
-      ++states[update.state];
+      tally.add(update.state);
       if (log.is_open()) {
         log << k << "," << index << "," << std::fixed << std::setprecision(3) << ms[k] << ","
             << resident[k] << "," << cvo::toString(update.state) << "\n";
@@ -99,12 +99,9 @@ int main(int argc, char** argv) {
     const double growth = resident.back() - resident[warmup];
     std::cout << std::fixed << std::setprecision(1) << "soak: " << frames << " frames of "
               << input.kind << " (" << n << " frames back and forth), backend "
-              << odometry.registration().backend().name() << "\n"
-              << "states: " << states[cvo::TrackingState::kTracking] << " tracking, "
-              << states[cvo::TrackingState::kRecovered] << " recovered, "
-              << states[cvo::TrackingState::kLost] << " lost, "
-              << states[cvo::TrackingState::kReset] << " resets\n"
-              << "resident memory: " << resident[0] << " MiB after frame 0, " << resident[warmup]
+              << odometry.registration().backend().name() << "\n";
+    tally.print(std::cout);
+    std::cout << "resident memory: " << resident[0] << " MiB after frame 0, " << resident[warmup]
               << " MiB after warm-up (frame " << warmup << "), " << resident.back()
               << " MiB at the end (peak after warm-up " << peak_after << " MiB); growth " << growth
               << " MiB\n"

@@ -24,17 +24,8 @@ const std::string kData = CVO_TEST_DATA_DIR;
 const std::string kPair = kData + "/kitti_stereo_pair";
 const std::string kKitti = kData + "/kitti_06_stereo";
 
-// Calibration published with the pair (KITTI odometry 00-02 geometry).
-cvo::PinholeIntrinsics pairIntrinsics() {
-  cvo::PinholeIntrinsics K;
-  K.fx = K.fy = 718.856;
-  K.cx = 607.1928;
-  K.cy = 185.2157;
-  K.width = 1241;
-  K.height = 376;
-  return K;
-}
-constexpr double kPairBaseline = 0.537;
+using cvo_test::kPairBaseline;
+using cvo_test::pairIntrinsics;
 
 cv::Mat readGrey(const std::string& path) {
   cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);

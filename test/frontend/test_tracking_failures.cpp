@@ -155,12 +155,8 @@ TEST(TrackingFailures, StereoFramesWithoutOverlapAreFlagged) {
   cvo::StereoFrame other;
   other.left = cv::imread(kData + "/kitti_stereo_pair/left.png", cv::IMREAD_GRAYSCALE);
   other.right = cv::imread(kData + "/kitti_stereo_pair/right.png", cv::IMREAD_GRAYSCALE);
-  other.intrinsics.fx = other.intrinsics.fy = 718.856;
-  other.intrinsics.cx = 607.1928;
-  other.intrinsics.cy = 185.2157;
-  other.intrinsics.width = 1241;
-  other.intrinsics.height = 376;
-  other.baseline = 0.537;
+  other.intrinsics = cvo_test::pairIntrinsics();
+  other.baseline = cvo_test::kPairBaseline;
 
   FrameToFrameOdometry odometry(preset("kitti_stereo.yaml"));
   odometry.process(0.0, kitti06(0));
@@ -230,7 +226,7 @@ TEST(TrackingFailures, TooManyLostFramesInARowRestartTracking) {
   EXPECT_EQ(reset.state, TrackingState::kReset);
   EXPECT_FALSE(odometry.hasReference()) << "a frame without a cloud leaves no reference";
   const OdometryUpdate restart = odometry.process(5 * kFrame, tum.cloud(5));
-  EXPECT_TRUE(restart.first_frame);
+  EXPECT_TRUE(restart.firstFrame());
   EXPECT_EQ(restart.pose.matrix(), reset.pose.matrix());
 }
 

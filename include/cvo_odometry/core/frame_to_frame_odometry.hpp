@@ -28,7 +28,6 @@ std::string toString(TrackingState state);
 
 struct OdometryUpdate {
   TrackingState state = TrackingState::kFirstFrame;
-  bool first_frame = false;  // state == kFirstFrame
   // False for a lost frame under LostFramePolicy::kPublishNothing: report no pose.
   bool has_pose = true;
   double stamp = 0.0;
@@ -42,6 +41,13 @@ struct OdometryUpdate {
   std::string problem;        // why a registration was judged bad (also after a recovery)
   // Points of the reference the frame was registered to.
   std::size_t reference_points = 0;
+
+  bool firstFrame() const { return state == TrackingState::kFirstFrame; }
+  // The pose comes from a registration judged good (or is the start of a trajectory).
+  bool trusted() const {
+    return state == TrackingState::kTracking || state == TrackingState::kRecovered ||
+           (firstFrame() && problem.empty());
+  }
 };
 
 class FrameToFrameOdometry {
@@ -82,6 +88,9 @@ class FrameToFrameOdometry {
   OdometryUpdate startFrom(double stamp, std::optional<LabeledCloud> cloud, const std::string& why);
   Eigen::Isometry3d predictedMotion(double dt) const;
   void accept(OdometryUpdate& update, LabeledCloud cloud);
+  // `cloud` becomes the reference at the current pose; none when it is missing or has fewer
+  // than min_tracking_points.
+  void setReference(std::optional<LabeledCloud> cloud, double stamp);
   void lose(OdometryUpdate& update, std::optional<LabeledCloud> cloud, const std::string& why);
 
   CvoRegistration registration_;
