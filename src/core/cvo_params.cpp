@@ -65,6 +65,8 @@ void CvoParams::validate() const {
   requirePositive(max_linear_speed, "max_linear_speed");
   requirePositive(max_angular_speed, "max_angular_speed");
   require(max_lost_frames >= 0, "max_lost_frames must be >= 0");
+  require(photometric_iterations >= 1, "photometric_iterations must be >= 1");
+  requirePositive(photometric_max_correction, "photometric_max_correction");
 }
 
 double CvoParams::maxKernelWeight() const {

@@ -74,6 +74,16 @@ FrameToFrameOdometry::Attempt FrameToFrameOdometry::attempt(const LabeledCloud& 
     }
     a.cosine = cross / std::sqrt(referenceSelfProduct(ell) * source_self_->second);
   }
+  if (registration_.params().photometric_rotation) {
+    if (reference_->image() && cloud.image()) {
+      PhotometricRotationResult refined = refineRotationPhotometrically(
+          *reference_->image(), *cloud.image(), cloud, a.result.transform, registration_.params());
+      a.result.transform = refined.transform;
+      a.photometric = refined.report;
+    } else {
+      a.photometric.skipped = "the clouds carry no image";
+    }
+  }
   const TrackingCheck check =
       checkRegistration(report, a.cosine, a.result.transform, dt, registration_.params());
   a.good = check.good;
@@ -120,6 +130,7 @@ OdometryUpdate FrameToFrameOdometry::process(double stamp, LabeledCloud cloud) {
     update.problem = first.problems;
   }
   update.report = first.result.report;
+  update.photometric = first.photometric;
   update.cosine = first.cosine;
   if (!first.good) {
     lose(update, std::move(cloud), update.problem);

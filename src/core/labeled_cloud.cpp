@@ -34,6 +34,7 @@ void LabeledCloud::add(const Eigen::Vector3f& position, const float* color,
 
 LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
   LabeledCloud out = *this;
+  out.image_.reset();
   for (std::size_t i = 0; i < size(); ++i) {
     Eigen::Map<Eigen::Vector3f>(&out.positions_[3 * i]) = T * position(i);
   }

@@ -44,6 +44,9 @@ void visitScalars(Params& p, Visitor&& f) {
   f("subsample_coarse_levels", p.subsample_coarse_levels);
   f("max_overrelaxation", p.max_overrelaxation);
   f("max_level_iterations", p.max_level_iterations);
+  f("photometric_rotation", p.photometric_rotation);
+  f("photometric_iterations", p.photometric_iterations);
+  f("photometric_max_correction", p.photometric_max_correction);
   f("num_threads", p.num_threads);
   f("min_cosine", p.min_cosine);
   f("min_tracking_points", p.min_tracking_points);
@@ -152,7 +155,8 @@ void parseKeyValueLines(std::istream& in, const std::string& source_name,
 
 const std::vector<std::string>& frontendPresetKeys() {
   static const std::vector<std::string> keys{"point_selector", "min_points", "max_points",
-                                             "min_depth",      "max_depth",  "crop_top_rows"};
+                                             "min_depth",      "max_depth",  "crop_top_rows",
+                                             "image_levels"};
   return keys;
 }
 

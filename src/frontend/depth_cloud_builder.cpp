@@ -1,11 +1,13 @@
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/empty_frame_error.hpp"
@@ -32,6 +34,31 @@ void CloudBuilderOptions::validate() const {
                                 std::to_string(selector.max_points) + "] makes no sense");
   }
   if (semantic_classes < 0) throw std::invalid_argument("semantic_classes must be >= 0");
+  if (image_levels < 0 || image_levels > 6) {
+    throw std::invalid_argument("image_levels must be in [0, 6]");
+  }
+}
+
+std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
+                                                     const PinholeIntrinsics& K, int levels) {
+  if (levels <= 0 || !CameraModel::supportsDistortion(K.distortion.size())) return nullptr;
+  cv::Mat grey;
+  toGrey(image).convertTo(grey, CV_32F, 1.0 / 255.0);
+  std::vector<IntensityImage::Level> out;
+  for (int l = 0; l < levels; ++l) {
+    IntensityImage::Level level;
+    level.blur_sigma = l + 1 < levels ? std::ldexp(1.0, levels - 2 - l) : 0.0;
+    cv::Mat blurred;  // a new buffer: blurring into a header of `grey` would blur it in place
+    if (level.blur_sigma > 0.0) {
+      cv::GaussianBlur(grey, blurred, cv::Size(), level.blur_sigma);
+    } else {
+      blurred = grey;
+    }
+    level.values.assign(blurred.begin<float>(), blurred.end<float>());
+    out.push_back(std::move(level));
+  }
+  return std::make_shared<const IntensityImage>(
+      image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion), std::move(out));
 }
 
 std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
@@ -108,6 +135,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   if (cloud.size() == 0) {
     throw EmptyFrameError("every selected pixel belongs to an ignored class");
   }
+  cloud.setImage(intensityImage(image, intrinsics, options_.image_levels));
   local.valid_depth_pixels = valid_count;
   local.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

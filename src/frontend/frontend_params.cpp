@@ -52,6 +52,8 @@ void setFrontendParam(CloudBuilderOptions& options, const std::string& key,
     options.max_depth = toNumber(key, value);
   } else if (key == "crop_top_rows") {
     options.crop_top_rows = toInt(key, value);
+  } else if (key == "image_levels") {
+    options.image_levels = toInt(key, value);
   } else {
     throw std::invalid_argument("unknown front-end parameter '" + key + "'");
   }

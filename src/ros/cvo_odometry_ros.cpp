@@ -64,7 +64,8 @@ std::string describe(const CvoParams& params, const CloudBuilderOptions& cloud) 
                                                        : "mixed")
       << "\nmin_points: " << cloud.selector.min_points
       << "\nmax_points: " << cloud.selector.max_points << "\nmin_depth: " << cloud.min_depth
-      << "\nmax_depth: " << cloud.max_depth << "\ncrop_top_rows: " << cloud.crop_top_rows << "\n";
+      << "\nmax_depth: " << cloud.max_depth << "\ncrop_top_rows: " << cloud.crop_top_rows
+      << "\nimage_levels: " << cloud.image_levels << "\n";
   return out.str();
 }
 
@@ -117,6 +118,9 @@ CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   initial.max_angular_speed = params_.max_angular_speed;
   initial.lost_frame_policy = toString(params_.lost_frame_policy);
   initial.max_lost_frames = params_.max_lost_frames;
+  initial.photometric_rotation = params_.photometric_rotation;
+  initial.photometric_iterations = params_.photometric_iterations;
+  initial.photometric_max_correction = params_.photometric_max_correction;
   reconfigure_->updateConfig(initial);
   reconfigure_->setCallback(
       [this](CvoOdometryConfig& config, uint32_t level) { onReconfigure(config, level); });
@@ -168,6 +172,7 @@ void CvoOdometryRos::loadParameters() {
   override(pnh_, "min_depth", &cloud_options_.min_depth);
   override(pnh_, "max_depth", &cloud_options_.max_depth);
   override(pnh_, "crop_top_rows", &cloud_options_.crop_top_rows);
+  override(pnh_, "image_levels", &cloud_options_.image_levels);
   std::string selector;
   if (pnh_.getParam("point_selector", selector)) {
     cloud_options_.selector.kind = parseSelectorKind(selector);
@@ -464,6 +469,9 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const OdometryUpdat
   indicator.initial_lengthscale = update.report.initial_lengthscale;
   indicator.final_lengthscale = update.report.final_lengthscale;
   indicator.converged = update.firstFrame() || update.report.converged;
+  indicator.photometric_applied = update.photometric.applied;
+  indicator.photometric_correction_deg = update.photometric.correction_deg;
+  indicator.photometric_skipped = update.photometric.skipped;
   indicator.registration_ms = update.report.time_ms;
   indicator.frontend_ms = stats.time_ms;
   indicator.source_points = static_cast<uint32_t>(cloud ? cloud->size() : 0);
@@ -573,6 +581,9 @@ void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
   next.max_linear_speed = config.max_linear_speed;
   next.max_angular_speed = config.max_angular_speed;
   next.max_lost_frames = config.max_lost_frames;
+  next.photometric_rotation = config.photometric_rotation;
+  next.photometric_iterations = config.photometric_iterations;
+  next.photometric_max_correction = config.photometric_max_correction;
   CloudBuilderOptions cloud = cloud_options_;
   cloud.selector.min_points = config.min_points;
   cloud.selector.max_points = config.max_points;

@@ -82,6 +82,7 @@ int main(int argc, char** argv) {
       if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
       if (update.attempts > 0) {
         timer.add("registration", update.report.time_ms);
+        if (update.photometric.applied) timer.add("photometric", update.photometric.time_ms);
         timer.add("total", std::chrono::duration<double, std::milli>(
                                std::chrono::steady_clock::now() - frame_start)
                                .count());

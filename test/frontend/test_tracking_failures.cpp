@@ -37,6 +37,16 @@ cvo::CvoParams preset(const std::string& name) {
   return params;
 }
 
+// The TUM preset with the colour kernel on: its cosine then judges appearance too, so a frame
+// whose image went blank over real depth is lost (the preset itself registers depth only and
+// tracks such a frame by its geometry; see BlackImageUnderTheGeometricPreset).
+cvo::CvoParams colourKernelPreset() {
+  cvo::CvoParams params = preset("tum_rgbd.yaml");
+  params.use_color = true;
+  params.ell_min = 0.05;
+  return params;
+}
+
 // Frames of the TUM fixture through the TUM preset's front end; images can be altered first.
 class TumFrames {
  public:
@@ -87,7 +97,7 @@ TEST(TrackingFailures, TheWholeTumFixtureTracksWithoutAFalseAlarm) {
 
 TEST(TrackingFailures, ABlankImageIsFlaggedNotTrusted) {
   const TumFrames tum;
-  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  FrameToFrameOdometry odometry(colourKernelPreset());
   odometry.process(0.0, tum.cloud(0));
   const OdometryUpdate good = odometry.process(kFrame, tum.cloud(1));
   ASSERT_EQ(good.state, TrackingState::kTracking);
@@ -180,9 +190,28 @@ TEST(TrackingFailures, StereoFramesWithoutOverlapAreFlagged) {
   EXPECT_LT(angleDeg(error), 0.2);
 }
 
+TEST(TrackingFailures, BlackImageUnderTheGeometricPreset) {
+  // Depth still real: CVO tracks the frame by geometry; the photometric stage sees images that
+  // do not match and keeps CVO's rotation instead of fitting noise.
+  const TumFrames tum;
+  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  odometry.process(0.0, tum.cloud(0));
+  const OdometryUpdate good = odometry.process(kFrame, tum.cloud(1));
+  ASSERT_TRUE(good.photometric.applied) << good.photometric.skipped;
+  EXPECT_GT(good.photometric.correlation, 0.9);
+  cvo::RgbdFrame blank = tum.frame(2);
+  blank.image.setTo(cv::Scalar::all(0));
+  const OdometryUpdate u = odometry.process(2 * kFrame, tum.cloud(blank));
+  print("black image, geometric preset", u);
+  EXPECT_EQ(u.state, TrackingState::kTracking) << u.problem;
+  EXPECT_FALSE(u.photometric.applied);
+  EXPECT_NE(u.photometric.skipped.find("images do not match"), std::string::npos)
+      << u.photometric.skipped;
+}
+
 TEST(TrackingFailures, PublishNothingReportsNoPoseForALostFrame) {
   const TumFrames tum;
-  cvo::CvoParams params = preset("tum_rgbd.yaml");
+  cvo::CvoParams params = colourKernelPreset();
   params.lost_frame_policy = cvo::LostFramePolicy::kPublishNothing;
   FrameToFrameOdometry odometry(params);
   odometry.process(0.0, tum.cloud(0));

@@ -35,12 +35,12 @@ TEST_F(LiveControl, ReconfigureMalformedFramesTimeJumpAndReset) {
   EXPECT_TRUE(indicator(0).first_frame);
   EXPECT_FALSE(indicator(1).first_frame);
   EXPECT_TRUE(indicator(1).converged) << indicator(1).message;
-  EXPECT_NEAR(indicator(1).final_lengthscale, 0.05, 1e-9);  // the preset's ell_min
+  EXPECT_NEAR(indicator(1).final_lengthscale, 0.02, 1e-9);  // the preset's ell_min
   const auto fields = cloudFields();
   EXPECT_NE(std::find(fields.begin(), fields.end(), "label"), fields.end())
       << "segmentation labels in the debug cloud";
 
-  // dynamic_reconfigure: ell_min 0.05 -> 0.03, visible in the next report.
+  // dynamic_reconfigure: ell_min 0.02 -> 0.03, visible in the next report.
   dynamic_reconfigure::Reconfigure change;
   dynamic_reconfigure::DoubleParameter ell_min;
   ell_min.name = "ell_min";

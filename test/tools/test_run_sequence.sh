@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# cvo_run_sequence end to end on the fixtures. TUM fr1_xyz (colour, the TUM preset): frame-to-frame
-# RPE below the best of PCL GICP / NDT / Open3D colored ICP in translation (GICP: 3.60 mm) and
-# below every geometric peer in rotation (OpenCV ICPOdometry: 0.438 deg), README's peer table.
+# cvo_run_sequence end to end on the fixtures. TUM fr1_xyz (the TUM preset: geometric CVO and the
+# photometric rotation stage): frame-to-frame RPE below the paper's baselines PCL GICP / NDT /
+# Open3D colored ICP in translation (best: GICP 3.60 mm) and in rotation (best: colored ICP
+# 0.348 deg), which also puts it below every geometric peer (ICPOdometry 0.438 deg); README's
+# peer table (the runner measured 1.87 mm and 0.172 deg).
 # KITTI 06 frames 0-7 (stereo): RPE below 5 cm and 0.15 deg per frame (the runner measured 2.1 cm
 # and 0.065 deg over 51 frames). Also: trajectory files, the plot and a clear error.
 set -euo pipefail
@@ -17,7 +19,7 @@ tum="$root/test/data/tum_fr1_xyz"
   --gt "$tum/groundtruth.txt" --out "$work/tum.txt" --plot "$work/tum.png" | tee "$work/tum_report.txt"
 t=$(rpe "$work/tum_report.txt" m) r=$(rpe "$work/tum_report.txt" deg)
 awk -v t="$t" 'BEGIN { exit !(t < 0.00360) }' || fail "TUM RPE $t m, bound 0.00360"
-awk -v r="$r" 'BEGIN { exit !(r < 0.438) }' || fail "TUM RPE $r deg, bound 0.438"
+awk -v r="$r" 'BEGIN { exit !(r < 0.348) }' || fail "TUM RPE $r deg, bound 0.348"
 [ "$(grep -vc '^#' "$work/tum.txt")" = 37 ] || fail "TUM trajectory should have 37 poses"
 [ -s "$work/tum.png" ] || fail "no plot written"
 

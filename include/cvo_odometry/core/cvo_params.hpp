@@ -63,6 +63,13 @@ struct CvoParams {
   // Iterations after which a coarse level ends even if its steps are not yet small.
   int max_level_iterations = 30;
 
+  // Photometric rotation stage after CVO (see photometric_rotation.hpp): needs clouds that carry
+  // their image (the RGB-D front end attaches it). Gauss-Newton iterations per image level; a
+  // correction above photometric_max_correction (deg) is refused and CVO's rotation kept.
+  bool photometric_rotation = false;
+  int photometric_iterations = 10;
+  double photometric_max_correction = 2.0;
+
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;  // 0: all cores
 

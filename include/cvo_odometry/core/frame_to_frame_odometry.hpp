@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/photometric_rotation.hpp"
 
 namespace cvo {
 
@@ -34,11 +35,12 @@ struct OdometryUpdate {
   double dt = 0.0;                                           // seconds since the reference frame
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();    // start <- current
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // reference <- current
-  RegistrationReport report;  // of the registration used (the retry's after a retry)
-  double cosine = 0.0;        // at the result and final lengthscale; 0 without a registration
-  int attempts = 0;           // registrations run for this frame: 0, 1 or 2
-  int lost_frames = 0;        // consecutive lost frames up to and including this one
-  std::string problem;        // why a registration was judged bad (also after a recovery)
+  RegistrationReport report;      // of the registration used (the retry's after a retry)
+  PhotometricReport photometric;  // of the photometric rotation stage, when it is on
+  double cosine = 0.0;            // at the result and final lengthscale; 0 without a registration
+  int attempts = 0;               // registrations run for this frame: 0, 1 or 2
+  int lost_frames = 0;            // consecutive lost frames up to and including this one
+  std::string problem;            // why a registration was judged bad (also after a recovery)
   // Points of the reference the frame was registered to.
   std::size_t reference_points = 0;
 
@@ -75,6 +77,7 @@ class FrameToFrameOdometry {
  private:
   struct Attempt {
     RegistrationResult result;
+    PhotometricReport photometric;
     double cosine = 0.0;
     std::string problems;
     bool good = false;

@@ -6,11 +6,13 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/pair_kernels.hpp"
 
 namespace cvo {
@@ -46,7 +48,13 @@ class LabeledCloud {
   const std::vector<float>& colorData() const { return colors_; }
   const std::vector<float>& semanticData() const { return semantics_; }
 
-  // A copy with every position moved by `T` (features unchanged).
+  // The grey image the points were selected from (for the photometric rotation stage), or null.
+  // Shared: copies of a cloud refer to the same image.
+  const IntensityImage* image() const { return image_.get(); }
+  void setImage(std::shared_ptr<const IntensityImage> image) { image_ = std::move(image); }
+
+  // A copy with every position moved by `T` (features unchanged, no image: the image no longer
+  // matches the positions).
   LabeledCloud transformed(const Eigen::Isometry3f& T) const;
   // Every `stride`-th point, starting with the first.
   LabeledCloud strided(std::size_t stride) const;
@@ -59,6 +67,7 @@ class LabeledCloud {
   std::vector<float> positions_;
   std::vector<float> colors_;
   std::vector<float> semantics_;
+  std::shared_ptr<const IntensityImage> image_;
 };
 
 }  // namespace cvo

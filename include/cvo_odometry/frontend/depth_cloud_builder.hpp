@@ -2,10 +2,12 @@
 // forward, x right, y down). The RGB-D and stereo front ends both end here.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 #include "cvo_odometry/frontend/point_selector.hpp"
@@ -17,6 +19,9 @@ struct CloudBuilderOptions {
   double max_depth = 10.0;
   int crop_top_rows = 0;  // rows at the top never selected (KITTI: sky and stereo-less band)
   SelectorOptions selector;
+  // Blur levels of the grey image attached to each cloud for the photometric rotation stage
+  // (sigmas ..., 2, 1, 0 px; 0: no image attached).
+  int image_levels = 2;
   int semantic_classes = 0;  // > 0: a segmentation image is expected
   std::vector<int> ignore_classes;
 
@@ -29,6 +34,12 @@ struct FrontendStats {
   std::size_t valid_depth_pixels = 0;
   double time_ms = 0.0;
 };
+
+// The grey image for the photometric stage: `levels` blurs of `image` (8-bit BGR or grey), or
+// null when levels is 0 or the distortion model is not one CameraModel projects.
+std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
+                                                     const PinholeIntrinsics& intrinsics,
+                                                     int levels);
 
 // Rays (x/z, y/z) through pixel centres, undistorted when the intrinsics carry distortion.
 std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,

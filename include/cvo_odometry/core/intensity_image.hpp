@@ -1,0 +1,47 @@
+// A grey camera image for the photometric rotation stage: one or more levels of the same image
+// blurred by decreasing amounts (coarse first), each with its intensity gradients, and the camera
+// model that projects points into it. Built by the front end (which owns OpenCV); the core only
+// samples it.
+#pragma once
+
+#include <vector>
+
+#include "cvo_odometry/core/camera_model.hpp"
+
+namespace cvo {
+
+struct IntensitySample {
+  double intensity = 0.0, gradient_u = 0.0, gradient_v = 0.0;
+};
+
+class IntensityImage {
+ public:
+  struct Level {
+    double blur_sigma = 0.0;    // pixels, of the Gaussian applied by whoever built it
+    std::vector<float> values;  // row-major width x height, intensity in [0, 1]
+  };
+
+  // Throws std::invalid_argument for an empty size, no level, or a level of the wrong size.
+  IntensityImage(int width, int height, const CameraModel& camera, std::vector<Level> levels);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int levelCount() const { return static_cast<int>(levels_.size()); }
+  double blurSigma(int level) const { return levels_[level].blur_sigma; }
+  const CameraModel& camera() const { return camera_; }
+
+  // True when (u, v) is far enough inside for bilinear sampling of the central differences.
+  bool inside(double u, double v) const {
+    return u >= 1.0 && v >= 1.0 && u <= width_ - 2.0 && v <= height_ - 2.0;
+  }
+  // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v).
+  IntensitySample sample(int level, double u, double v) const;
+
+ private:
+  int width_, height_;
+  CameraModel camera_;
+  std::vector<Level> levels_;
+  std::vector<std::vector<float>> gradient_u_, gradient_v_;  // per level, central differences
+};
+
+}  // namespace cvo

@@ -1,0 +1,48 @@
+// The photometric rotation stage (after CVO, when CvoParams::photometric_rotation is on).
+//
+// Why: an RGB-D camera's depth and colour are not captured at the same instant (the Kinect of
+// TUM fr1 stamps depth 12-20 ms before colour, and its geometry behaves as if older still), and
+// the registration of depth geometry reports the rotation of the depth's time. The colour image
+// fixes rotation best: image-plane motion is dominated by rotation, hardly by depth errors.
+// So the CVO pose (translation and rotation) starts a robust Gauss-Newton alignment of the
+// current cloud's own intensities with the reference image (6-DoF, coarse blur level first,
+// Huber weights at 1.345 x the residuals' MAD scale), and only its rotation is kept: the
+// translation stays CVO's, which the depth observes better than the image does.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/cvo_params.hpp"
+#include "cvo_odometry/core/intensity_image.hpp"
+#include "cvo_odometry/core/labeled_cloud.hpp"
+
+namespace cvo {
+
+struct PhotometricReport {
+  bool applied = false;
+  std::string skipped;          // why the stage left CVO's rotation, empty when applied
+  int iterations = 0;           // Gauss-Newton iterations over all levels
+  std::size_t points = 0;       // points inside the reference image at the last iteration
+  double correction_deg = 0.0;  // angle between CVO's rotation and the refined one
+  double correlation = 0.0;     // of the cloud's intensities with the reference's at the result
+  double time_ms = 0.0;
+};
+
+struct PhotometricRotationResult {
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // reference <- current
+  PhotometricReport report;
+};
+
+// `reference_from_current`: CVO's estimate. Returns it unchanged (with `skipped` set) when the
+// images' levels differ, too few points (< params.min_tracking_points) land in the reference
+// image, the solve degenerates, the intensities correlate below 0.5 at the result (the images
+// do not show the same scene: a black frame, a covered lens), or the correction exceeds
+// params.photometric_max_correction.
+PhotometricRotationResult refineRotationPhotometrically(
+    const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
+    const Eigen::Isometry3d& reference_from_current, const CvoParams& params);
+
+}  // namespace cvo

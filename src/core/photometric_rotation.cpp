@@ -1,0 +1,149 @@
+#include "cvo_odometry/core/photometric_rotation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "cvo_odometry/core/lie_group.hpp"
+
+namespace cvo {
+
+namespace {
+
+constexpr double kHuberScale = 1.345;  // 95% efficiency under Gaussian residuals
+constexpr double kMadToSigma = 1.4826;
+constexpr double kStepTolerance = 1e-7;
+// Below this correlation of the current intensities with the reference's at the result the two
+// images do not show the same scene (a covered lens, a black frame): the rotation is not taken.
+constexpr double kMinCorrelation = 0.5;
+
+// Median of |r| (partially sorts a copy).
+double medianAbsolute(const std::vector<double>& residuals) {
+  std::vector<double> a(residuals.size());
+  std::transform(residuals.begin(), residuals.end(), a.begin(),
+                 [](double r) { return std::abs(r); });
+  const auto middle = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
+  std::nth_element(a.begin(), middle, a.end());
+  return *middle;
+}
+
+}  // namespace
+
+PhotometricRotationResult refineRotationPhotometrically(
+    const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
+    const Eigen::Isometry3d& reference_from_current, const CvoParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  PhotometricRotationResult out;
+  out.transform = reference_from_current;
+  PhotometricReport& report = out.report;
+  auto finish = [&](const std::string& skipped) {
+    report.skipped = skipped;
+    report.applied = skipped.empty();
+    if (!report.applied) out.transform = reference_from_current;
+    report.time_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  };
+  if (reference.levelCount() != current.levelCount()) return finish("image levels differ");
+  for (int l = 0; l < reference.levelCount(); ++l) {
+    if (reference.blurSigma(l) != current.blurSigma(l)) return finish("image levels differ");
+  }
+  const std::size_t minimum = static_cast<std::size_t>(params.min_tracking_points);
+  const std::size_t n = cloud.size();
+  std::vector<Eigen::Vector3d> points(n);
+  for (std::size_t j = 0; j < n; ++j)
+    points[j] = cloud.position(j).cast<double>();
+
+  Eigen::Isometry3d T = reference_from_current;
+  std::vector<double> own(n), residuals, sampled_own;
+  std::vector<Eigen::Matrix<double, 6, 1>> jacobians;
+  residuals.reserve(n);
+  jacobians.reserve(n);
+  for (int level = 0; level < reference.levelCount(); ++level) {
+    // Each point's intensity in its own image (where it was selected), at this blur.
+    for (std::size_t j = 0; j < n; ++j) {
+      own[j] = NAN;
+      if (!(points[j].z() > 0.0)) continue;
+      const Eigen::Vector2d p = current.camera().project(points[j]);
+      if (current.inside(p.x(), p.y())) own[j] = current.sample(level, p.x(), p.y()).intensity;
+    }
+    for (int it = 0; it < params.photometric_iterations; ++it) {
+      residuals.clear();
+      jacobians.clear();
+      sampled_own.clear();
+      for (std::size_t j = 0; j < n; ++j) {
+        if (std::isnan(own[j])) continue;
+        const Eigen::Vector3d Y = T * points[j];
+        if (!(Y.z() > 0.0)) continue;
+        const Eigen::Vector2d p = reference.camera().project(Y);
+        if (!reference.inside(p.x(), p.y())) continue;
+        const IntensitySample s = reference.sample(level, p.x(), p.y());
+        // d I / d Y, then the left perturbation Y + omega x Y + v.
+        const Eigen::Vector3d dI = reference.camera().pinholeJacobian(Y).transpose() *
+                                   Eigen::Vector2d(s.gradient_u, s.gradient_v);
+        Eigen::Matrix<double, 6, 1> J;
+        J << Y.cross(dI), dI;
+        residuals.push_back(s.intensity - own[j]);
+        sampled_own.push_back(own[j]);
+        jacobians.push_back(J);
+      }
+      report.points = residuals.size();
+      if (residuals.size() < std::max<std::size_t>(minimum, 6)) {
+        return finish("only " + std::to_string(residuals.size()) +
+                      " points inside the reference image");
+      }
+      const double scale = std::max(kMadToSigma * medianAbsolute(residuals), 1e-6);
+      const double huber = kHuberScale * scale;
+      Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+      for (std::size_t k = 0; k < residuals.size(); ++k) {
+        const double r = residuals[k];
+        const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+        H.selfadjointView<Eigen::Lower>().rankUpdate(jacobians[k], w);
+        g += w * r * jacobians[k];
+      }
+      H = H.selfadjointView<Eigen::Lower>();
+      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
+      const Eigen::Matrix<double, 6, 1> xi = -ldlt.solve(g);
+      ++report.iterations;
+      if (ldlt.info() != Eigen::Success || !xi.allFinite()) return finish("degenerate solve");
+      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+      step.linear() = lie::expSO3(xi.head<3>());
+      step.translation() = xi.tail<3>();
+      T = step * T;
+      if (xi.norm() < kStepTolerance) break;
+    }
+  }
+  // Correlation of own and reference intensities (reference = own + residual) at the last step.
+  double mean_own = 0.0, mean_ref = 0.0;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    mean_own += sampled_own[k];
+    mean_ref += sampled_own[k] + residuals[k];
+  }
+  mean_own /= residuals.size();
+  mean_ref /= residuals.size();
+  double s_oo = 0.0, s_rr = 0.0, s_or = 0.0;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    const double o = sampled_own[k] - mean_own, r = sampled_own[k] + residuals[k] - mean_ref;
+    s_oo += o * o;
+    s_rr += r * r;
+    s_or += o * r;
+  }
+  report.correlation = s_oo > 0.0 && s_rr > 0.0 ? s_or / std::sqrt(s_oo * s_rr) : 0.0;
+  if (!(report.correlation >= kMinCorrelation)) {
+    return finish("images do not match (intensity correlation " +
+                  std::to_string(report.correlation) + ")");
+  }
+  const Eigen::AngleAxisd change(T.linear() * reference_from_current.linear().transpose());
+  report.correction_deg = std::abs(change.angle()) * 180.0 / M_PI;
+  if (!(report.correction_deg <= params.photometric_max_correction)) {
+    return finish("correction " + std::to_string(report.correction_deg) +
+                  " deg > photometric_max_correction");
+  }
+  out.transform.linear() = lie::orthonormalized(T).linear();
+  out.transform.translation() = reference_from_current.translation();
+  return finish("");
+}
+
+}  // namespace cvo
