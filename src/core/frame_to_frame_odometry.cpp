@@ -74,7 +74,13 @@ FrameToFrameOdometry::Attempt FrameToFrameOdometry::attempt(const LabeledCloud& 
     }
     a.cosine = cross / std::sqrt(referenceSelfProduct(ell) * source_self_->second);
   }
-  if (registration_.params().photometric_rotation) {
+  const TrackingCheck check =
+      checkRegistration(report, a.cosine, a.result.transform, dt, registration_.params());
+  a.good = check.good;
+  a.problems = check.problems;
+  // Only a registration judged good is refined: the stage starts from CVO's pose, and a bad
+  // attempt is retried or lost anyway, so its image alignment would be wasted.
+  if (a.good && registration_.params().photometric_rotation) {
     if (reference_->image() && cloud.image()) {
       PhotometricRotationResult refined = refineRotationPhotometrically(
           *reference_->image(), *cloud.image(), cloud, a.result.transform, registration_.params());
@@ -84,10 +90,6 @@ FrameToFrameOdometry::Attempt FrameToFrameOdometry::attempt(const LabeledCloud& 
       a.photometric.skipped = "the clouds carry no image";
     }
   }
-  const TrackingCheck check =
-      checkRegistration(report, a.cosine, a.result.transform, dt, registration_.params());
-  a.good = check.good;
-  a.problems = check.problems;
   return a;
 }
 

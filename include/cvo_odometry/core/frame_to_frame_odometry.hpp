@@ -36,7 +36,7 @@ struct OdometryUpdate {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();    // start <- current
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // reference <- current
   RegistrationReport report;      // of the registration used (the retry's after a retry)
-  PhotometricReport photometric;  // of the photometric rotation stage, when it is on
+  PhotometricReport photometric;  // of the photometric stage (run on a good registration)
   double cosine = 0.0;            // at the result and final lengthscale; 0 without a registration
   int attempts = 0;               // registrations run for this frame: 0, 1 or 2
   int lost_frames = 0;            // consecutive lost frames up to and including this one
