@@ -1,0 +1,233 @@
+// OrderedStampPairer on the real stamps of the TUM fr1_xyz excerpt (rgb.txt, depth.txt; the
+// dataset's associations.txt is the truth), in the arrival orders a bag or a live camera gives.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cvo_odometry/frontend/dataset_files.hpp"
+#include "cvo_odometry/frontend/ordered_stamp_pairer.hpp"
+
+namespace cvo {
+namespace {
+
+using Pairer = OrderedStampPairer<int, int>;
+
+struct TumStamps {
+  std::vector<double> rgb, depth;
+  std::vector<int> depth_of_rgb;  // associations.txt: depth index of each rgb index
+};
+
+TumStamps loadTumStamps() {
+  const std::string folder = std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz/";
+  TumStamps stamps;
+  for (const auto& row : readFieldRows(folder + "rgb.txt", 2)) {
+    stamps.rgb.push_back(parseFiniteNumber(row[0], "rgb.txt"));
+  }
+  for (const auto& row : readFieldRows(folder + "depth.txt", 2)) {
+    stamps.depth.push_back(parseFiniteNumber(row[0], "depth.txt"));
+  }
+  for (const auto& row : readFieldRows(folder + "associations.txt", 4)) {
+    const double depth = parseFiniteNumber(row[2], "associations.txt");
+    const auto found = std::find(stamps.depth.begin(), stamps.depth.end(), depth);
+    stamps.depth_of_rgb.push_back(static_cast<int>(found - stamps.depth.begin()));
+  }
+  return stamps;
+}
+
+// One message: stream (0 colour, 1 depth) and index.
+struct Arrival {
+  int stream;
+  int index;
+};
+
+// Each stream's messages in order, merged by arrival time = stamp + that stream's delay.
+std::vector<Arrival> arrivals(const TumStamps& stamps, double rgb_delay, double depth_delay) {
+  std::vector<std::pair<double, Arrival>> timed;
+  for (std::size_t k = 0; k < stamps.rgb.size(); ++k) {
+    timed.push_back({stamps.rgb[k] + rgb_delay, {0, static_cast<int>(k)}});
+  }
+  for (std::size_t k = 0; k < stamps.depth.size(); ++k) {
+    timed.push_back({stamps.depth[k] + depth_delay, {1, static_cast<int>(k)}});
+  }
+  std::stable_sort(timed.begin(), timed.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Arrival> order;
+  for (const auto& t : timed)
+    order.push_back(t.second);
+  return order;
+}
+
+std::vector<Pairer::Pair> feed(Pairer& pairer, const TumStamps& stamps,
+                               const std::vector<Arrival>& order) {
+  std::vector<Pairer::Pair> pairs;
+  for (const Arrival& a : order) {
+    auto done = a.stream == 0 ? pairer.addFirst(stamps.rgb[a.index], a.index)
+                              : pairer.addSecond(stamps.depth[a.index], a.index);
+    pairs.insert(pairs.end(), done.begin(), done.end());
+  }
+  return pairs;
+}
+
+void expectTruePairs(const TumStamps& stamps, const std::vector<Pairer::Pair>& pairs) {
+  for (const auto& pair : pairs) {
+    EXPECT_EQ(pair.second, stamps.depth_of_rgb[pair.first]) << "rgb " << pair.first;
+  }
+  for (std::size_t k = 1; k < pairs.size(); ++k) {
+    EXPECT_LT(pairs[k - 1].first, pairs[k].first) << "pairs out of order";
+  }
+}
+
+TEST(OrderedStampPairer, NearestStampPairingIsWrongOnThisExcerpt) {
+  // Why the pairer exists: depth 31 is nearer to rgb 30 than to rgb 31, its true partner.
+  const TumStamps stamps = loadTumStamps();
+  ASSERT_EQ(stamps.rgb.size(), 37u);
+  ASSERT_EQ(stamps.depth_of_rgb[31], 31);
+  EXPECT_LT(std::abs(stamps.depth[31] - stamps.rgb[30]),
+            std::abs(stamps.depth[31] - stamps.rgb[31]));
+}
+
+TEST(OrderedStampPairer, PairsTheWholeTumExcerptInBagOrder) {
+  const TumStamps stamps = loadTumStamps();
+  Pairer pairer;
+  const auto pairs = feed(pairer, stamps, arrivals(stamps, 0.0, 0.0));
+  ASSERT_EQ(pairs.size(), 37u);
+  expectTruePairs(stamps, pairs);
+  EXPECT_EQ(pairer.droppedFirst(), 0u);
+  EXPECT_EQ(pairer.droppedSecond(), 0u);
+  ASSERT_TRUE(pairer.offset().has_value());
+  EXPECT_NEAR(*pairer.offset(), -0.0155, 0.003);  // depth about 15 ms older than colour
+  EXPECT_NEAR(*pairer.tolerance(), 0.4 * 0.032, 0.002);
+}
+
+TEST(OrderedStampPairer, PairsWhicheverStreamArrivesLate) {
+  const TumStamps stamps = loadTumStamps();
+  // Depth processed 50 ms late (a registration step in the driver), then colour 80 ms late.
+  for (const auto& [rgb_delay, depth_delay] : {std::pair{0.0, 0.05}, std::pair{0.08, 0.0}}) {
+    Pairer pairer;
+    const auto pairs = feed(pairer, stamps, arrivals(stamps, rgb_delay, depth_delay));
+    ASSERT_EQ(pairs.size(), 37u) << rgb_delay << " " << depth_delay;
+    expectTruePairs(stamps, pairs);
+  }
+}
+
+TEST(OrderedStampPairer, PairsUnderRandomInterleaving) {
+  // Each topic in order, the two interleaved at random (separate subscriber threads).
+  const TumStamps stamps = loadTumStamps();
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Arrival> order;
+    std::size_t next_rgb = 0, next_depth = 0;
+    while (next_rgb < stamps.rgb.size() || next_depth < stamps.depth.size()) {
+      // Neither stream runs more than 3 frames ahead of the other, as a bounded queue would.
+      const bool rgb_ahead = next_rgb > next_depth + 2, depth_ahead = next_depth > next_rgb + 2;
+      const bool take_rgb =
+          next_depth == stamps.depth.size() ||
+          (next_rgb < stamps.rgb.size() && !rgb_ahead && (depth_ahead || random() % 2 == 0));
+      order.push_back(take_rgb ? Arrival{0, static_cast<int>(next_rgb++)}
+                               : Arrival{1, static_cast<int>(next_depth++)});
+    }
+    Pairer pairer;
+    const auto pairs = feed(pairer, stamps, order);
+    EXPECT_EQ(pairs.size(), 37u) << "trial " << trial;
+    expectTruePairs(stamps, pairs);
+  }
+}
+
+TEST(OrderedStampPairer, MissingMessagesLeaveTheirPartnerUnpaired) {
+  const TumStamps stamps = loadTumStamps();
+  std::vector<Arrival> order;
+  for (const Arrival& a : arrivals(stamps, 0.0, 0.0)) {
+    const bool lost = (a.stream == 1 && a.index == 10) || (a.stream == 0 && a.index == 20);
+    if (!lost) order.push_back(a);
+  }
+  Pairer pairer;
+  const auto pairs = feed(pairer, stamps, order);
+  EXPECT_EQ(pairs.size(), 35u);
+  expectTruePairs(stamps, pairs);
+  EXPECT_EQ(pairer.droppedFirst(), 1u);   // rgb 10: its depth never came
+  EXPECT_EQ(pairer.droppedSecond(), 1u);  // depth 20: its colour never came
+}
+
+TEST(OrderedStampPairer, ALoopingBagStartsOverWithoutMixingLoops) {
+  const TumStamps stamps = loadTumStamps();
+  const auto once = arrivals(stamps, 0.0, 0.0);
+  std::vector<Arrival> twice = once;
+  twice.insert(twice.end(), once.begin(), once.end());
+  Pairer pairer;
+  const auto pairs = feed(pairer, stamps, twice);
+  EXPECT_EQ(pairer.restarts(), 1u);
+  EXPECT_EQ(pairs.size(), 74u);
+  for (const auto& pair : pairs)
+    EXPECT_EQ(pair.second, stamps.depth_of_rgb[pair.first]);
+}
+
+TEST(OrderedStampPairer, ASilentStreamKeepsTheQueueBounded) {
+  const TumStamps stamps = loadTumStamps();
+  StampPairerOptions options;
+  options.queue_size = 10;
+  Pairer pairer(options);
+  for (std::size_t k = 0; k < stamps.rgb.size(); ++k) {
+    EXPECT_TRUE(pairer.addFirst(stamps.rgb[k], static_cast<int>(k)).empty());
+  }
+  EXPECT_EQ(pairer.droppedFirst(), 27u);
+  EXPECT_FALSE(pairer.offset().has_value());
+  // Depth from the start of the excerpt (a bag whose depth topic lags): the colour frames the
+  // queue kept pair with their own depth, once it comes, and nothing earlier is mispaired.
+  std::size_t paired = 0;
+  for (std::size_t k = 0; k < stamps.depth.size(); ++k) {
+    for (const auto& pair : pairer.addSecond(stamps.depth[k], static_cast<int>(k))) {
+      EXPECT_EQ(pair.second, stamps.depth_of_rgb[pair.first]);
+      ++paired;
+    }
+  }
+  EXPECT_EQ(paired, 10u);  // rgb 27..36, all that the queue kept
+}
+
+TEST(OrderedStampPairer, FixedZeroOffsetPairsEqualStampsOnly) {
+  // A segmentation image stamped with its colour image's stamp.
+  StampPairerOptions options;
+  options.fixed_offset = 0.0;
+  Pairer pairer(options);
+  const std::vector<double> colour = {10.000, 10.033, 10.066, 10.100, 10.133};
+  std::vector<std::pair<int, int>> paired;
+  auto keep = [&](const std::vector<Pairer::Pair>& pairs) {
+    for (const auto& p : pairs)
+      paired.push_back({p.first, p.second});
+  };
+  for (int k = 0; k < 5; ++k)
+    keep(pairer.addFirst(colour[k], k));
+  // Labels come late; the one for frame 2 is missing and frame 3's is stamped 1 ms off.
+  keep(pairer.addSecond(colour[0], 100));
+  keep(pairer.addSecond(colour[1], 101));
+  keep(pairer.addSecond(colour[3] + 0.001, 103));
+  keep(pairer.addSecond(colour[4], 104));
+  const std::vector<std::pair<int, int>> expected = {{0, 100}, {1, 101}, {4, 104}};
+  EXPECT_EQ(paired, expected);
+  EXPECT_EQ(pairer.droppedFirst(), 2u);
+  EXPECT_EQ(pairer.droppedSecond(), 1u);
+}
+
+TEST(OrderedStampPairer, RejectsBadStampsAndOptions) {
+  Pairer pairer;
+  EXPECT_TRUE(pairer.addFirst(std::numeric_limits<double>::quiet_NaN(), 0).empty());
+  EXPECT_TRUE(pairer.addFirst(1.0, 1).empty());
+  EXPECT_TRUE(pairer.addFirst(1.0, 2).empty());  // repeated stamp
+  EXPECT_EQ(pairer.droppedFirst(), 2u);
+  StampPairerOptions bad;
+  bad.tolerance = -1.0;
+  EXPECT_THROW(Pairer{bad}, std::invalid_argument);
+  bad = StampPairerOptions();
+  bad.queue_size = 2;
+  EXPECT_THROW(Pairer{bad}, std::invalid_argument);
+  bad = StampPairerOptions();
+  bad.fixed_offset = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(Pairer{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace cvo
