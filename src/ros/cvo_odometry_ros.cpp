@@ -3,9 +3,6 @@
 #include <fstream>
 #include <sstream>
 
-#include <message_filters/sync_policies/approximate_time.h>
-#include <message_filters/sync_policies/exact_time.h>
-#include <message_filters/synchronizer.h>
 #include <nav_msgs/Odometry.h>
 #include <boost/function.hpp>
 
@@ -20,34 +17,12 @@
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/empty_frame_error.hpp"
 #include "cvo_odometry/frontend/frontend_params.hpp"
+#include "cvo_odometry/ros/policy_synchronizer.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
 
 namespace cvo {
 
 namespace {
-
-namespace sp = message_filters::sync_policies;
-
-// A synchronizer of `filters` with the exact or approximate policy, calling `object->*method`.
-// `frame_interval` > 0 tells the approximate policy that messages on one topic are at least that
-// far apart, so it can pair an image with the right depth when their stamps differ by up to half
-// a frame (TUM's depth is 12-20 ms older than its colour at 30 Hz).
-template <class... M, class T>
-std::shared_ptr<void> synchronize(bool approximate, int queue, double frame_interval,
-                                  void (T::*method)(const boost::shared_ptr<const M>&...),
-                                  T* object, message_filters::SimpleFilter<M>&... filters) {
-  if (approximate) {
-    using Sync = message_filters::Synchronizer<sp::ApproximateTime<M...>>;
-    auto sync = std::make_shared<Sync>(sp::ApproximateTime<M...>(queue), filters...);
-    if (frame_interval > 0.0) sync->setInterMessageLowerBound(ros::Duration(frame_interval));
-    sync->registerCallback(method, object);
-    return sync;
-  }
-  using Sync = message_filters::Synchronizer<sp::ExactTime<M...>>;
-  auto sync = std::make_shared<Sync>(sp::ExactTime<M...>(queue), filters...);
-  sync->registerCallback(method, object);
-  return sync;
-}
 
 // Every parameter, from the preset file first and then single ROS parameters of the same name.
 template <class T>
@@ -211,12 +186,43 @@ void CvoOdometryRos::makeCloudBuilders() {
 
 void CvoOdometryRos::subscribe() {
   int queue = 10;
-  bool approximate = true;
   pnh_.param("queue_size", queue, queue);
-  pnh_.param("approximate_sync", approximate, approximate);
   double frame_interval = 0.0;
   pnh_.param("min_frame_interval", frame_interval, frame_interval);
+  std::string policy_name = mode_ == Mode::kRgbd ? "ordered" : "exact";
+  bool approximate = false;
+  if (pnh_.getParam("approximate_sync", approximate)) {
+    ROS_WARN(
+        "cvo_odometry: approximate_sync is deprecated; use sync_policy (exact, approximate "
+        "or ordered)");
+    policy_name = approximate ? "approximate" : "exact";
+  }
+  pnh_.param("sync_policy", policy_name, policy_name);
+  const SyncPolicy policy = parseSyncPolicy(policy_name);
+  ROS_INFO_STREAM("cvo_odometry: sync_policy " << toString(policy) << ", queue_size " << queue);
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
+  if (mode_ == Mode::kRgbd) {
+    // camera_info is not synchronized: the latest one is used (it rarely changes), which keeps
+    // the synchronization to the streams whose stamps really differ.
+    rgb_info_sub_ = nh_.subscribe<sensor_msgs::CameraInfo>(
+        "rgb/camera_info", 1, [this](const sensor_msgs::CameraInfoConstPtr& info) {
+          std::lock_guard<std::mutex> lock(info_mutex_);
+          rgb_info_ = info;
+        });
+    RgbdSyncOptions options;
+    options.policy = policy;
+    options.queue_size = queue;
+    options.min_frame_interval = frame_interval;
+    pnh_.param("sync_tolerance", options.tolerance, options.tolerance);
+    options.with_labels = use_segmentation_;
+    rgbd_sync_ = std::make_unique<RgbdTopicSync>(
+        it_, hints, options,
+        [this](const sensor_msgs::ImageConstPtr& image, const sensor_msgs::ImageConstPtr& depth,
+               const sensor_msgs::ImageConstPtr& labels) {
+          onRgbdWithLabels(image, depth, labels);
+        });
+    return;
+  }
   auto image = [&](const std::string& topic) {
     auto filter = std::make_shared<image_transport::SubscriberFilter>(it_, topic, queue, hints);
     filters_.push_back(filter);
@@ -228,42 +234,20 @@ void CvoOdometryRos::subscribe() {
     filters_.push_back(filter);
     return filter;
   };
-  if (mode_ == Mode::kRgbd) {
-    // camera_info is not synchronized: the latest one is used (it rarely changes), which keeps
-    // the approximate policy to the two streams whose stamps really differ.
-    rgb_info_sub_ = nh_.subscribe<sensor_msgs::CameraInfo>(
-        "rgb/camera_info", 1, [this](const sensor_msgs::CameraInfoConstPtr& info) {
-          std::lock_guard<std::mutex> lock(info_mutex_);
-          rgb_info_ = info;
-        });
-    auto rgb = image("rgb/image_rect_color");
-    countArrivals(*rgb);
-    auto depth = image("depth_registered/image_rect");
-    if (use_segmentation_) {
-      auto labels = image("segmentation/image");
-      sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onRgbdWithLabels,
-                          this, *rgb, *depth, *labels);
-    } else {
-      sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onRgbdImages, this,
-                          *rgb, *depth);
-    }
-  } else if (mode_ == Mode::kStereo) {
-    auto left = image("left/image_rect");
-    countArrivals(*left);
-    auto left_info = info("left/camera_info");
+  auto left = image("left/image_rect");
+  countArrivals(*left);
+  auto left_info = info("left/camera_info");
+  if (mode_ == Mode::kStereo) {
     auto right = image("right/image_rect");
     auto right_info = info("right/camera_info");
-    sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onStereoImages, this,
-                        *left, *left_info, *right, *right_info);
+    sync_ = synchronize(policy, queue, frame_interval, &CvoOdometryRos::onStereoImages, this, *left,
+                        *left_info, *right, *right_info);
   } else {
-    auto left = image("left/image_rect");
-    countArrivals(*left);
-    auto left_info = info("left/camera_info");
     auto disparity = std::make_shared<message_filters::Subscriber<stereo_msgs::DisparityImage>>(
         nh_, "disparity", queue);
     filters_.push_back(disparity);
-    sync_ = synchronize(approximate, queue, frame_interval, &CvoOdometryRos::onStereoDisparity,
-                        this, *left, *left_info, *disparity);
+    sync_ = synchronize(policy, queue, frame_interval, &CvoOdometryRos::onStereoDisparity, this,
+                        *left, *left_info, *disparity);
   }
 }
 
@@ -271,11 +255,6 @@ void CvoOdometryRos::countArrivals(image_transport::SubscriberFilter& images) {
   // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
   images.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
       [this](const sensor_msgs::ImageConstPtr&) { ++arrived_; }));
-}
-
-void CvoOdometryRos::onRgbdImages(const sensor_msgs::ImageConstPtr& image,
-                                  const sensor_msgs::ImageConstPtr& depth) {
-  onRgbdWithLabels(image, depth, nullptr);
 }
 
 void CvoOdometryRos::onRgbdWithLabels(const sensor_msgs::ImageConstPtr& image,
@@ -667,7 +646,11 @@ void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("frames", frames_);
   status.add("skipped frames", skipped_);
   const std::size_t handled = frames_ + skipped_;
-  status.add("frames not synchronized", arrived_ > handled ? arrived_ - handled : 0);
+  const std::size_t arrived = rgbd_sync_ ? rgbd_sync_->arrived() : arrived_.load();
+  status.add("frames not synchronized", arrived > handled ? arrived - handled : 0);
+  if (const auto offset = rgbd_sync_ ? rgbd_sync_->learnedOffset() : std::nullopt) {
+    status.add("depth - colour stamp offset (ms)", *offset * 1000.0);
+  }
   status.add("lost frames", lost_);
   status.add("recovered frames", recovered_);
   status.add("tracking restarts", tracking_resets_);

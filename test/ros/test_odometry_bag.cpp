@@ -2,7 +2,7 @@
 // odometry and indicator messages and checks them against the fixture's ground truth.
 // Parameters (private): ground_truth, ground_truth_times (KITTI), stamp_offset (s added to the
 // ground truth's stamps, as cvo_make_bag does for KITTI), frames (expected), min_frames (fewest
-// accepted: approximate sync may drop a pair), max_final_error_m, max_rpe_m and max_rpe_deg (per
+// accepted, e.g. when a synchronization policy may drop a pair), max_final_error_m, max_rpe_m and max_rpe_deg (per
 // frame) or max_rpe_mps and max_rpe_dps (per second), timeout_s, nearest_association.
 #include <gtest/gtest.h>
 

@@ -32,6 +32,7 @@
 #include "cvo_odometry/core/trajectory.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+#include "cvo_odometry/ros/rgbd_topic_sync.hpp"
 
 namespace cvo {
 
@@ -57,8 +58,6 @@ class CvoOdometryRos {
   void onRgbd(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info,
               const sensor_msgs::ImageConstPtr& depth, const sensor_msgs::ImageConstPtr& labels);
   void countArrivals(image_transport::SubscriberFilter& images);
-  void onRgbdImages(const sensor_msgs::ImageConstPtr& image,
-                    const sensor_msgs::ImageConstPtr& depth);
   void onRgbdWithLabels(const sensor_msgs::ImageConstPtr& image,
                         const sensor_msgs::ImageConstPtr& depth,
                         const sensor_msgs::ImageConstPtr& labels);
@@ -124,14 +123,14 @@ class CvoOdometryRos {
   std::size_t lost_ = 0, recovered_ = 0, tracking_resets_ = 0, backend_fallbacks_ = 0;
   bool lost_now_ = false;  // the latest frame was lost
   std::string lost_problem_;
-  std::atomic<std::size_t> arrived_{0};  // images of the main stream, before synchronization
+  std::atomic<std::size_t> arrived_{0};  // stereo: left images, before synchronization
   std::string last_problem_;
 
   image_transport::ImageTransport it_;
   // Members are destroyed in reverse order: the synchronizer before the filters it is
   // connected to, the reconfigure server before its mutex.
   std::vector<std::shared_ptr<void>> filters_;
-  std::shared_ptr<void> sync_;  // the message_filters synchronizer of the chosen mode
+  std::shared_ptr<void> sync_;  // stereo: the message_filters synchronizer
   std::mutex info_mutex_;
   sensor_msgs::CameraInfoConstPtr rgb_info_;  // latest rgb/camera_info
   ros::Subscriber rgb_info_sub_;
@@ -147,6 +146,7 @@ class CvoOdometryRos {
   std::unique_ptr<diagnostic_updater::HeaderlessTopicDiagnostic> rate_diagnostic_;
   double min_rate_ = 1.0, max_rate_ = 100.0;
   ros::Timer diagnostics_timer_;
+  std::unique_ptr<RgbdTopicSync> rgbd_sync_;  // RGB-D topics; destroyed first, ending callbacks
 };
 
 }  // namespace cvo

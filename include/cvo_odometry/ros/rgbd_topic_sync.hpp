@@ -1,0 +1,80 @@
+// The RGB-D topics (colour, depth, optional segmentation) subscribed and synchronized by the
+// chosen policy: message_filters' exact or approximate policy, or the ordered pairing of colour
+// and depth with a learned stamp offset (a segmentation image then pairs by its colour stamp).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <image_transport/image_transport.h>
+#include <image_transport/subscriber_filter.h>
+#include <sensor_msgs/Image.h>
+
+#include "cvo_odometry/frontend/ordered_stamp_pairer.hpp"
+#include "cvo_odometry/ros/policy_synchronizer.hpp"
+
+namespace cvo {
+
+struct RgbdSyncOptions {
+  SyncPolicy policy = SyncPolicy::kOrdered;
+  int queue_size = 30;
+  double min_frame_interval = 0.0;  // approximate: the frame period's lower bound (s), 0 unknown
+  double tolerance = 0.0;           // ordered: the pairing tolerance (s), 0 automatic
+  bool with_labels = false;         // subscribe segmentation/image too
+};
+
+class RgbdTopicSync {
+ public:
+  // Colour, depth and labels (null without segmentation), one frame at a time in stamp order.
+  using Callback = std::function<void(const sensor_msgs::ImageConstPtr& image,
+                                      const sensor_msgs::ImageConstPtr& depth,
+                                      const sensor_msgs::ImageConstPtr& labels)>;
+
+  // Subscribes rgb/image_rect_color, depth_registered/image_rect and, with labels,
+  // segmentation/image through `it`. Throws std::invalid_argument for bad options.
+  RgbdTopicSync(image_transport::ImageTransport& it, const image_transport::TransportHints& hints,
+                const RgbdSyncOptions& options, Callback callback);
+
+  // Colour images received, paired or not.
+  std::size_t arrived() const { return arrived_; }
+  // Ordered policy: the learned depth - colour stamp offset (s), once known.
+  std::optional<double> learnedOffset() const;
+
+ private:
+  using ImagePtr = sensor_msgs::ImageConstPtr;
+  using ColourDepth = std::pair<ImagePtr, ImagePtr>;
+
+  void subscribeOrdered(image_transport::ImageTransport& it,
+                        const image_transport::TransportHints& hints);
+  void subscribeFilters(image_transport::ImageTransport& it,
+                        const image_transport::TransportHints& hints);
+  void onPairs(const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs);
+  void onSynchronized(const ImagePtr& image, const ImagePtr& depth) {
+    callback_(image, depth, nullptr);
+  }
+  void onSynchronizedWithLabels(const ImagePtr& image, const ImagePtr& depth,
+                                const ImagePtr& labels) {
+    callback_(image, depth, labels);
+  }
+
+  RgbdSyncOptions options_;
+  Callback callback_;
+  std::atomic<std::size_t> arrived_{0};
+  std::atomic<double> offset_;  // NaN until learned
+
+  // Ordered policy: pairing and delivery under one lock, so frames leave in stamp order.
+  std::mutex mutex_;
+  std::optional<OrderedStampPairer<ImagePtr, ImagePtr>> colour_depth_;
+  std::optional<OrderedStampPairer<ColourDepth, ImagePtr>> with_labels_;
+  // Destroyed first (reverse order): no callback runs into a half-destroyed object.
+  std::vector<image_transport::Subscriber> subscribers_;
+  std::vector<std::shared_ptr<image_transport::SubscriberFilter>> filters_;
+  std::shared_ptr<void> sync_;
+};
+
+}  // namespace cvo

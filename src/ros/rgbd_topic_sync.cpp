@@ -1,0 +1,107 @@
+#include "cvo_odometry/ros/rgbd_topic_sync.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <boost/function.hpp>
+
+namespace cvo {
+
+RgbdTopicSync::RgbdTopicSync(image_transport::ImageTransport& it,
+                             const image_transport::TransportHints& hints,
+                             const RgbdSyncOptions& options, Callback callback)
+    : options_(options),
+      callback_(std::move(callback)),
+      offset_(std::numeric_limits<double>::quiet_NaN()) {
+  if (options_.queue_size < 1) throw std::invalid_argument("queue_size must be >= 1");
+  if (options_.policy == SyncPolicy::kOrdered) {
+    subscribeOrdered(it, hints);
+  } else {
+    subscribeFilters(it, hints);
+  }
+}
+
+std::optional<double> RgbdTopicSync::learnedOffset() const {
+  const double offset = offset_;
+  return std::isnan(offset) ? std::nullopt : std::optional<double>(offset);
+}
+
+void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
+                                     const image_transport::TransportHints& hints) {
+  StampPairerOptions pairing;
+  pairing.tolerance = options_.tolerance;
+  pairing.queue_size = std::max<std::size_t>(static_cast<std::size_t>(options_.queue_size),
+                                             pairing.bootstrap_frames);
+  colour_depth_.emplace(pairing);
+  if (options_.with_labels) {
+    StampPairerOptions exact = pairing;
+    exact.fixed_offset = 0.0;  // a segmentation image carries its colour image's stamp
+    exact.tolerance = 0.0;
+    with_labels_.emplace(exact);
+  }
+  const auto queue = static_cast<uint32_t>(options_.queue_size);
+  subscribers_.push_back(
+      it.subscribe("rgb/image_rect_color", queue,
+                   boost::function<void(const ImagePtr&)>([this](const ImagePtr& image) {
+                     ++arrived_;
+                     std::lock_guard<std::mutex> lock(mutex_);
+                     onPairs(colour_depth_->addFirst(image->header.stamp.toSec(), image));
+                   }),
+                   ros::VoidPtr(), hints));
+  subscribers_.push_back(
+      it.subscribe("depth_registered/image_rect", queue,
+                   boost::function<void(const ImagePtr&)>([this](const ImagePtr& depth) {
+                     std::lock_guard<std::mutex> lock(mutex_);
+                     onPairs(colour_depth_->addSecond(depth->header.stamp.toSec(), depth));
+                   }),
+                   ros::VoidPtr(), hints));
+  if (!with_labels_) return;
+  subscribers_.push_back(it.subscribe(
+      "segmentation/image", queue,
+      boost::function<void(const ImagePtr&)>([this](const ImagePtr& labels) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (auto& frame : with_labels_->addSecond(labels->header.stamp.toSec(), labels)) {
+          callback_(frame.first.first, frame.first.second, frame.second);
+        }
+      }),
+      ros::VoidPtr(), hints));
+}
+
+void RgbdTopicSync::onPairs(
+    const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs) {
+  if (const auto offset = colour_depth_->offset()) offset_ = *offset;
+  for (const auto& pair : pairs) {
+    if (!with_labels_) {
+      callback_(pair.first, pair.second, nullptr);
+      continue;
+    }
+    for (auto& frame : with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second})) {
+      callback_(frame.first.first, frame.first.second, frame.second);
+    }
+  }
+}
+
+void RgbdTopicSync::subscribeFilters(image_transport::ImageTransport& it,
+                                     const image_transport::TransportHints& hints) {
+  auto image = [&](const std::string& topic) {
+    filters_.push_back(
+        std::make_shared<image_transport::SubscriberFilter>(it, topic, options_.queue_size, hints));
+    return filters_.back();
+  };
+  auto rgb = image("rgb/image_rect_color");
+  // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
+  rgb->registerCallback(
+      boost::function<void(const ImagePtr&)>([this](const ImagePtr&) { ++arrived_; }));
+  auto depth = image("depth_registered/image_rect");
+  if (options_.with_labels) {
+    auto labels = image("segmentation/image");
+    sync_ = synchronize(options_.policy, options_.queue_size, options_.min_frame_interval,
+                        &RgbdTopicSync::onSynchronizedWithLabels, this, *rgb, *depth, *labels);
+  } else {
+    sync_ = synchronize(options_.policy, options_.queue_size, options_.min_frame_interval,
+                        &RgbdTopicSync::onSynchronized, this, *rgb, *depth);
+  }
+}
+
+}  // namespace cvo
