@@ -11,10 +11,6 @@ namespace {
 constexpr double kMaxDenseCells = 4.0e6;
 }  // namespace
 
-int VoxelGrid::cellCoord(float v, int axis) const {
-  return static_cast<int>(std::floor((v - origin_[axis]) / cell_size_));
-}
-
 std::uint64_t VoxelGrid::key(int x, int y, int z) {
   // 21 bits per axis around an offset: cells of 1 cm still span +-10 km.
   constexpr std::uint64_t kMask = (1u << 21) - 1;
@@ -25,7 +21,7 @@ std::uint64_t VoxelGrid::key(int x, int y, int z) {
 }
 
 void VoxelGrid::build(const float* positions, std::size_t count, float cell_size) {
-  cell_size_ = cell_size;
+  shape_.cell = cell_size;
   float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
   for (int a = 0; a < 3; ++a) {
     lo[a] = count ? positions[a] : 0.0f;
@@ -39,18 +35,19 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
   }
   double cells = 1.0;
   for (int a = 0; a < 3; ++a) {
-    origin_[a] = lo[a];
-    dims_[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size)) + 1;
-    cells *= dims_[a];
+    shape_.origin[a] = lo[a];
+    shape_.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size)) + 1;
+    cells *= shape_.dims[a];
   }
   dense_ = cells <= kMaxDenseCells;
 
   std::vector<std::uint64_t> cell_of(count);
   for (std::size_t i = 0; i < count; ++i) {
     const float* p = positions + 3 * i;
-    const int x = cellCoord(p[0], 0), y = cellCoord(p[1], 1), z = cellCoord(p[2], 2);
-    cell_of[i] =
-        dense_ ? (static_cast<std::uint64_t>(x) * dims_[1] + y) * dims_[2] + z : key(x, y, z);
+    cell_of[i] = dense_ ? kernels::cellOfPoint(shape_, p)
+                        : key(kernels::cellCoordinate(shape_, p[0], 0),
+                              kernels::cellCoordinate(shape_, p[1], 1),
+                              kernels::cellCoordinate(shape_, p[2], 2));
   }
   order_.resize(count);
   std::iota(order_.begin(), order_.end(), 0u);

@@ -1,6 +1,8 @@
 // The CUDA side of the CUDA backend, with a plain interface (no Eigen, no CUDA types) so that
 // only src/core/cuda/device_pair_sums.cu needs nvcc. Device buffers persist and grow; clouds are
-// uploaded through pinned staging memory; the target's neighbour grid is built on the GPU.
+// uploaded through pinned staging memory; the target's neighbour grid (dense_grid.hpp, shared
+// with the CPU) is built on the GPU by a stable radix sort of the cell indices, without a host
+// wait; an evaluation sums on the device and waits once, for its result.
 // Every call throws std::runtime_error naming the failing CUDA call.
 #pragma once
 

@@ -72,6 +72,10 @@ CVO_HOST_DEVICE inline void add(MomentSums& m, const MomentSums& o) {
   m.pairs += o.pairs;
 }
 
+CVO_HOST_DEVICE inline void clear(TaylorSums& s) {
+  s.b = s.c = s.d = s.e = 0.0;
+}
+
 CVO_HOST_DEVICE inline void add(TaylorSums& s, const TaylorSums& o) {
   s.b += o.b;
   s.c += o.c;

@@ -1,11 +1,15 @@
 #include <cuda_runtime.h>
 
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "cvo_odometry/core/dense_grid.hpp"
 #include "cvo_odometry/core/device_pair_sums.hpp"
 
 namespace cvo {
@@ -30,6 +34,7 @@ struct DeviceBuffer {
     if (n <= capacity) return;
     if (data) cudaFree(data);
     data = nullptr;
+    capacity = 0;  // a failed allocation leaves an empty buffer, not a stale size
     check(cudaMalloc(&data, std::max<std::size_t>(n, 1) * sizeof(T)), "cudaMalloc");
     capacity = n;
   }
@@ -38,11 +43,17 @@ struct DeviceBuffer {
   }
 };
 
+// The pose and twist travel as kernel arguments: no copy, no host wait per evaluation.
+struct Pose3x4 {
+  float m[12];
+};
+struct Twist {
+  double v[6];
+};
+
 struct GridView {
-  float origin[3];
-  float cell;
-  int dims[3];
-  const unsigned int* start;  // dims product + 1 offsets into the sorted target arrays
+  kernels::DenseGridShape shape;
+  const unsigned int* start;  // cells + 1 offsets into the sorted target arrays
 };
 
 struct CloudView {
@@ -52,27 +63,14 @@ struct CloudView {
   int count;
 };
 
-__device__ int cellOf(float v, float origin, float cell) {
-  return static_cast<int>(floorf((v - origin) / cell));
-}
-
 // Visits the target points of the 9 z-columns around z (the grid cell is the query radius).
 template <class F>
 __device__ void forEachCandidate(const GridView& grid, const float* z, F&& f) {
-  const int cx = cellOf(z[0], grid.origin[0], grid.cell);
-  const int cy = cellOf(z[1], grid.origin[1], grid.cell);
-  const int cz = cellOf(z[2], grid.origin[2], grid.cell);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int x = cx + dx, y = cy + dy;
-      if (x < 0 || y < 0 || x >= grid.dims[0] || y >= grid.dims[1]) continue;
-      const int z0 = max(cz - 1, 0), z1 = min(cz + 1, grid.dims[2] - 1);
-      if (z0 > z1) continue;
-      const std::size_t column = (static_cast<std::size_t>(x) * grid.dims[1] + y) * grid.dims[2];
-      for (unsigned int k = grid.start[column + z0]; k < grid.start[column + z1 + 1]; ++k)
-        f(k);
-    }
-  }
+  kernels::forEachNeighbourRange(grid.shape, grid.start, z,
+                                 [&](unsigned int begin, unsigned int end) {
+                                   for (unsigned int k = begin; k < end; ++k)
+                                     f(k);
+                                 });
 }
 
 __device__ float pairAppearance(const kernels::KernelConstants& k, const CloudView& target, int i,
@@ -97,7 +95,7 @@ __device__ void blockReduce(Sums* shared, Sums value, Add add) {
 }
 
 __global__ void momentsKernel(CloudView target, CloudView source, GridView grid,
-                              kernels::KernelConstants k, const float* pose, float inv_two_ell2,
+                              kernels::KernelConstants k, Pose3x4 pose, float inv_two_ell2,
                               kernels::MomentSums* partial) {
   __shared__ kernels::MomentSums shared[kThreads];
   const int j = blockIdx.x * blockDim.x + threadIdx.x;
@@ -105,7 +103,7 @@ __global__ void momentsKernel(CloudView target, CloudView source, GridView grid,
   kernels::clear(mine);
   if (j < source.count) {
     float z[3];
-    kernels::transformPoint(pose, source.positions + 3 * j, z);
+    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
     kernels::PointSums sums;
     kernels::clear(sums);
     forEachCandidate(grid, z, [&](unsigned int i) {
@@ -123,16 +121,17 @@ __global__ void momentsKernel(CloudView target, CloudView source, GridView grid,
 }
 
 __global__ void taylorKernel(CloudView target, CloudView source, GridView grid,
-                             kernels::KernelConstants k, const float* pose, const double* xi,
-                             float inv_two_ell2, double inv_ell2, kernels::TaylorSums* partial) {
+                             kernels::KernelConstants k, Pose3x4 pose, Twist xi, float inv_two_ell2,
+                             double inv_ell2, kernels::TaylorSums* partial) {
   __shared__ kernels::TaylorSums shared[kThreads];
   const int j = blockIdx.x * blockDim.x + threadIdx.x;
-  kernels::TaylorSums mine{0.0, 0.0, 0.0, 0.0};
+  kernels::TaylorSums mine;
+  kernels::clear(mine);
   if (j < source.count) {
     float z[3];
-    kernels::transformPoint(pose, source.positions + 3 * j, z);
+    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
     kernels::TaylorFrame frame;
-    kernels::makeTaylorFrame(z, xi, frame);
+    kernels::makeTaylorFrame(z, xi.v, frame);
     forEachCandidate(grid, z, [&](unsigned int i) {
       const float* x = target.positions + 3 * i;
       const float a =
@@ -146,27 +145,31 @@ __global__ void taylorKernel(CloudView target, CloudView source, GridView grid,
   if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
 }
 
-// Grid build: cell of every target point, counting sort into cell order.
+// Grid build: the cell of every target point and the points per cell.
 __global__ void cellKernel(const float* positions, int count, GridView grid, unsigned int* cell,
                            unsigned int* counts) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= count) return;
-  const float* p = positions + 3 * i;
-  int c[3];
-  for (int a = 0; a < 3; ++a) {
-    c[a] = min(max(cellOf(p[a], grid.origin[a], grid.cell), 0), grid.dims[a] - 1);
-  }
-  cell[i] = static_cast<unsigned int>(
-      (static_cast<std::size_t>(c[0]) * grid.dims[1] + c[1]) * grid.dims[2] + c[2]);
-  atomicAdd(&counts[cell[i] + 1], 1u);
+  cell[i] = static_cast<unsigned int>(kernels::cellOfPoint(grid.shape, positions + 3 * i));
+  atomicAdd(&counts[cell[i]], 1u);
 }
 
-// Stable scatter (one thread walks the points in order: stable, and cheap for < 100k points).
-__global__ void scatterKernel(const unsigned int* cell, int count, unsigned int* fill,
-                              unsigned int* order) {
-  if (blockIdx.x != 0 || threadIdx.x != 0) return;
-  for (int i = 0; i < count; ++i)
-    order[fill[cell[i]]++] = static_cast<unsigned int>(i);
+// The per-block partial sums into one: thread t adds blocks t, t + kThreads, ... in order, then a
+// fixed tree (deterministic run to run).
+template <class Sums>
+__global__ void finalSumKernel(const Sums* partial, int blocks, Sums* total) {
+  __shared__ Sums shared[kThreads];
+  Sums mine;
+  kernels::clear(mine);
+  for (int b = threadIdx.x; b < blocks; b += blockDim.x)
+    kernels::add(mine, partial[b]);
+  blockReduce(shared, mine, [](Sums& a, const Sums& b) { kernels::add(a, b); });
+  if (threadIdx.x == 0) *total = shared[0];
+}
+
+__global__ void iotaKernel(unsigned int* values, int count) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < count) values[i] = static_cast<unsigned int>(i);
 }
 
 __global__ void gatherKernel(const unsigned int* order, int count, const float* positions,
@@ -193,13 +196,16 @@ struct DevicePairSums::Impl {
   // Raw uploads and the target sorted by cell.
   DeviceBuffer<float> raw[2][3];  // [target/source][positions, colors, semantics]
   DeviceBuffer<float> sorted[3];  // target in cell order
-  DeviceBuffer<unsigned int> cell, start, fill, order;
-  DeviceBuffer<float> pose;
-  DeviceBuffer<double> xi;
+  DeviceBuffer<unsigned int> cell, sorted_cell, counts, start, iota, order;
+  DeviceBuffer<unsigned char> scratch;  // CUB's temporary storage
   DeviceBuffer<kernels::MomentSums> moment_partials;
   DeviceBuffer<kernels::TaylorSums> taylor_partials;
+  DeviceBuffer<kernels::MomentSums> moment_total;
+  DeviceBuffer<kernels::TaylorSums> taylor_total;
   float* pinned = nullptr;  // staging for uploads
   std::size_t pinned_capacity = 0;
+  kernels::MomentSums* pinned_moments = nullptr;  // the one download of an evaluation
+  kernels::TaylorSums* pinned_taylor = nullptr;
   int count[2] = {0, 0};
   int classes = 0;
   bool has_color[2] = {false, false};
@@ -208,24 +214,32 @@ struct DevicePairSums::Impl {
   double cutoff2 = 0.0;
   double grid_cell = -1.0;
   GridView grid{};
-  std::vector<kernels::MomentSums> host_moments;
-  std::vector<kernels::TaylorSums> host_taylor;
 
-  void upload(DeviceBuffer<float>& buffer, const float* data, std::size_t n) {
-    buffer.reserve(n);
-    if (n == 0) return;
-    if (n > pinned_capacity) {
+  // Uploads the three arrays of a cloud through one pinned staging buffer and one wait.
+  void upload(int which, const float* const* data, const std::size_t* sizes) {
+    const std::size_t total = sizes[0] + sizes[1] + sizes[2];
+    if (total > pinned_capacity) {
       if (pinned) cudaFreeHost(pinned);
       pinned = nullptr;
-      check(cudaMallocHost(&pinned, n * sizeof(float)), "cudaMallocHost");
-      pinned_capacity = n;
+      pinned_capacity = 0;
+      check(cudaMallocHost(&pinned, total * sizeof(float)), "cudaMallocHost");
+      pinned_capacity = total;
     }
-    std::copy(data, data + n, pinned);
-    check(cudaMemcpyAsync(buffer.data, pinned, n * sizeof(float), cudaMemcpyHostToDevice, stream),
-          "upload");
+    std::size_t offset = 0;
+    for (int a = 0; a < 3; ++a) {
+      raw[which][a].reserve(sizes[a]);
+      if (sizes[a] == 0) continue;
+      std::copy(data[a], data[a] + sizes[a], pinned + offset);
+      check(cudaMemcpyAsync(raw[which][a].data, pinned + offset, sizes[a] * sizeof(float),
+                            cudaMemcpyHostToDevice, stream),
+            "upload");
+      offset += sizes[a];
+    }
     check(cudaStreamSynchronize(stream), "upload sync");  // the staging buffer is reused
   }
 
+  // The target sorted by grid cell (a stable radix sort of the cell indices) and each cell's
+  // first point (an exclusive scan of the cell counts), all on the device, no host wait.
   void buildGrid(double cell_size) {
     const int n = count[0];
     float lo[3], hi[3];
@@ -247,78 +261,84 @@ struct DevicePairSums::Impl {
     };
     while (cells(edge) > kMaxDenseCells)
       edge *= 1.5;
-    grid.cell = static_cast<float>(edge);
+    grid.shape.cell = static_cast<float>(edge);
     std::size_t total = 1;
     for (int a = 0; a < 3; ++a) {
-      grid.origin[a] = lo[a];
-      grid.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / edge)) + 1;
-      total *= static_cast<std::size_t>(grid.dims[a]);
+      grid.shape.origin[a] = lo[a];
+      grid.shape.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / edge)) + 1;
+      total *= static_cast<std::size_t>(grid.shape.dims[a]);
     }
-    reserveGrid(n, total);
-    check(cudaMemsetAsync(start.data, 0, (total + 1) * sizeof(unsigned int), stream), "memset");
-    const int blocks = (n + kThreads - 1) / kThreads;
+    int cell_bits = 1;
+    while ((std::size_t{1} << cell_bits) < total)
+      ++cell_bits;
+    std::size_t scan_bytes = 0, sort_bytes = 0;
+    check(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, counts.data, start.data,
+                                        static_cast<int>(total + 1), stream),
+          "scan size");
+    check(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, cell.data, sorted_cell.data,
+                                          iota.data, order.data, n, 0, cell_bits, stream),
+          "sort size");
+    reserveGrid(n, total, std::max(scan_bytes, sort_bytes));
+    check(cudaMemsetAsync(counts.data, 0, (total + 1) * sizeof(unsigned int), stream), "memset");
     if (n > 0) {
-      cellKernel<<<blocks, kThreads, 0, stream>>>(raw[0][0].data, n, grid, cell.data, start.data);
-      check(cudaGetLastError(), "cell kernel");
+      const int blocks = (n + kThreads - 1) / kThreads;
+      cellKernel<<<blocks, kThreads, 0, stream>>>(raw[0][0].data, n, grid, cell.data, counts.data);
+      iotaKernel<<<blocks, kThreads, 0, stream>>>(iota.data, n);
+      check(cudaGetLastError(), "cell kernels");
     }
-    // Prefix sum of the counts on the host (dims are small; a device scan is not worth it here).
-    std::vector<unsigned int> offsets(total + 1);
-    check(cudaMemcpyAsync(offsets.data(), start.data, (total + 1) * sizeof(unsigned int),
-                          cudaMemcpyDeviceToHost, stream),
-          "download counts");
-    check(cudaStreamSynchronize(stream), "counts sync");
-    for (std::size_t c = 1; c <= total; ++c)
-      offsets[c] += offsets[c - 1];
-    check(cudaMemcpyAsync(start.data, offsets.data(), (total + 1) * sizeof(unsigned int),
-                          cudaMemcpyHostToDevice, stream),
-          "upload offsets");
-    check(cudaMemcpyAsync(fill.data, offsets.data(), total * sizeof(unsigned int),
-                          cudaMemcpyHostToDevice, stream),
-          "upload fill");
+    // counts[total] stays 0, so the scan gives start[c] = first point of cell c and
+    // start[total] = n.
+    scan_bytes = scratch.capacity;
+    check(cub::DeviceScan::ExclusiveSum(scratch.data, scan_bytes, counts.data, start.data,
+                                        static_cast<int>(total + 1), stream),
+          "scan");
     if (n > 0) {
-      scatterKernel<<<1, 1, 0, stream>>>(cell.data, n, fill.data, order.data);
+      sort_bytes = scratch.capacity;
+      check(cub::DeviceRadixSort::SortPairs(scratch.data, sort_bytes, cell.data, sorted_cell.data,
+                                            iota.data, order.data, n, 0, cell_bits, stream),
+            "sort");
+      const int blocks = (n + kThreads - 1) / kThreads;
       gatherKernel<<<blocks, kThreads, 0, stream>>>(
           order.data, n, raw[0][0].data, has_color[0] ? raw[0][1].data : nullptr, raw[0][2].data,
           classes, sorted[0].data, sorted[1].data, sorted[2].data);
-      check(cudaGetLastError(), "grid kernels");
+      check(cudaGetLastError(), "gather kernel");
     }
-    check(cudaStreamSynchronize(stream), "grid sync");
     grid.start = start.data;
     grid_cell = cell_size;
   }
 
-  void reserveGrid(int n, std::size_t total) {
+  void reserveGrid(int n, std::size_t total, std::size_t scratch_bytes) {
     cell.reserve(n);
+    sorted_cell.reserve(n);
+    iota.reserve(n);
     order.reserve(n);
+    counts.reserve(total + 1);
     start.reserve(total + 1);
-    fill.reserve(total);
+    scratch.reserve(scratch_bytes);
     sorted[0].reserve(3 * static_cast<std::size_t>(n));
     sorted[1].reserve(kernels::kColorDim * static_cast<std::size_t>(n));
     sorted[2].reserve(static_cast<std::size_t>(classes) * n);
   }
 
-  // Grid for this lengthscale (rebuilt when it changed) and the pose on the device; returns the
-  // number of blocks, one source point a thread.
-  int prepare(const float* host_pose, double ell) {
+  // Grid for this lengthscale (rebuilt when it changed); returns the number of blocks, one
+  // source point a thread.
+  int prepare(double ell) {
     const double radius = std::sqrt(cutoff2) * ell;
     if (grid_cell != radius) buildGrid(radius);
-    check(cudaMemcpyAsync(pose.data, host_pose, 12 * sizeof(float), cudaMemcpyHostToDevice, stream),
-          "upload pose");
     return std::max(1, (count[1] + kThreads - 1) / kThreads);
   }
 
-  // Downloads the per-block partial sums and adds them in block order (deterministic).
+  // Adds the per-block partial sums on the device and waits for the one result.
   template <class Sums>
-  Sums sumPartials(const DeviceBuffer<Sums>& partials, std::vector<Sums>& host, int blocks) {
-    host.resize(blocks);
-    check(cudaMemcpyAsync(host.data(), partials.data, blocks * sizeof(Sums), cudaMemcpyDeviceToHost,
-                          stream),
-          "download partial sums");
+  Sums sumPartials(const DeviceBuffer<Sums>& partials, int blocks, DeviceBuffer<Sums>& total,
+                   Sums* pinned_total) {
+    total.reserve(1);
+    finalSumKernel<<<1, kThreads, 0, stream>>>(partials.data, blocks, total.data);
+    check(cudaGetLastError(), "sum kernel");
+    check(cudaMemcpyAsync(pinned_total, total.data, sizeof(Sums), cudaMemcpyDeviceToHost, stream),
+          "download sums");
     check(cudaStreamSynchronize(stream), "sums sync");
-    Sums total{};
-    for (const Sums& partial : host)
-      kernels::add(total, partial);
-    return total;
+    return *pinned_total;
   }
 
   CloudView targetView() const {
@@ -331,12 +351,14 @@ struct DevicePairSums::Impl {
 
 DevicePairSums::DevicePairSums() : impl_(std::make_unique<Impl>()) {
   check(cudaStreamCreateWithFlags(&impl_->stream, cudaStreamNonBlocking), "cudaStreamCreate");
-  impl_->pose.reserve(12);
-  impl_->xi.reserve(6);
+  check(cudaMallocHost(&impl_->pinned_moments, sizeof(kernels::MomentSums)), "cudaMallocHost");
+  check(cudaMallocHost(&impl_->pinned_taylor, sizeof(kernels::TaylorSums)), "cudaMallocHost");
 }
 
 DevicePairSums::~DevicePairSums() {
   if (impl_->pinned) cudaFreeHost(impl_->pinned);
+  if (impl_->pinned_moments) cudaFreeHost(impl_->pinned_moments);
+  if (impl_->pinned_taylor) cudaFreeHost(impl_->pinned_taylor);
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
 }
 
@@ -347,13 +369,13 @@ void DevicePairSums::setCloud(bool target, const float* positions, const float* 
   d.count[which] = count;
   d.classes = classes;
   d.has_color[which] = colors != nullptr;
-  d.upload(d.raw[which][0], positions, 3 * static_cast<std::size_t>(count));
-  d.upload(d.raw[which][1], colors ? colors : positions,
-           colors ? kernels::kColorDim * static_cast<std::size_t>(count) : 0);
-  d.upload(d.raw[which][2], semantics ? semantics : positions,
-           semantics ? static_cast<std::size_t>(classes) * count : 0);
+  const auto n = static_cast<std::size_t>(count);
+  const float* data[3] = {positions, colors, semantics};
+  const std::size_t sizes[3] = {3 * n, colors ? kernels::kColorDim * n : 0,
+                                semantics ? static_cast<std::size_t>(classes) * n : 0};
+  d.upload(which, data, sizes);
   if (target) {
-    d.host_positions.assign(positions, positions + 3 * static_cast<std::size_t>(count));
+    d.host_positions.assign(positions, positions + 3 * n);
     d.grid_cell = -1.0;  // rebuilt at the next evaluation
   }
 }
@@ -366,26 +388,30 @@ void DevicePairSums::setConstants(const kernels::KernelConstants& constants, dou
 
 kernels::MomentSums DevicePairSums::moments(const float* pose, double ell) {
   Impl& d = *impl_;
-  const int blocks = d.prepare(pose, ell);
+  const int blocks = d.prepare(ell);
   d.moment_partials.reserve(blocks);
+  Pose3x4 T;
+  std::copy(pose, pose + 12, T.m);
   momentsKernel<<<blocks, kThreads, 0, d.stream>>>(
-      d.targetView(), d.sourceView(), d.grid, d.constants, d.pose.data,
-      static_cast<float>(0.5 / (ell * ell)), d.moment_partials.data);
+      d.targetView(), d.sourceView(), d.grid, d.constants, T, static_cast<float>(0.5 / (ell * ell)),
+      d.moment_partials.data);
   check(cudaGetLastError(), "moments kernel");
-  return d.sumPartials(d.moment_partials, d.host_moments, blocks);
+  return d.sumPartials(d.moment_partials, blocks, d.moment_total, d.pinned_moments);
 }
 
 kernels::TaylorSums DevicePairSums::taylor(const float* pose, const double* xi, double ell) {
   Impl& d = *impl_;
-  const int blocks = d.prepare(pose, ell);
+  const int blocks = d.prepare(ell);
   d.taylor_partials.reserve(blocks);
-  check(cudaMemcpyAsync(d.xi.data, xi, 6 * sizeof(double), cudaMemcpyHostToDevice, d.stream),
-        "upload twist");
+  Pose3x4 T;
+  std::copy(pose, pose + 12, T.m);
+  Twist twist;
+  std::copy(xi, xi + 6, twist.v);
   taylorKernel<<<blocks, kThreads, 0, d.stream>>>(
-      d.targetView(), d.sourceView(), d.grid, d.constants, d.pose.data, d.xi.data,
+      d.targetView(), d.sourceView(), d.grid, d.constants, T, twist,
       static_cast<float>(0.5 / (ell * ell)), 1.0 / (ell * ell), d.taylor_partials.data);
   check(cudaGetLastError(), "taylor kernel");
-  return d.sumPartials(d.taylor_partials, d.host_taylor, blocks);
+  return d.sumPartials(d.taylor_partials, blocks, d.taylor_total, d.pinned_taylor);
 }
 
 bool cudaDeviceUsable(std::string* why_not) {

@@ -1,0 +1,71 @@
+// The dense neighbour grid (dense_grid.hpp), whose arithmetic the CPU VoxelGrid and the CUDA
+// kernels share: on a real TUM cloud every point within the radius is found, exactly once, and
+// every point lands in a cell of the box.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cvo_odometry/core/cloud_io.hpp"
+#include "cvo_odometry/core/dense_grid.hpp"
+#include "cvo_odometry/core/voxel_grid.hpp"
+
+namespace {
+
+const std::string kCloud = std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_8000.cloud";
+
+TEST(DenseGrid, FindsExactlyTheNeighboursWithinTheRadius) {
+  const cvo::LabeledCloud cloud = cvo::readCloud(kCloud);
+  const std::vector<float>& positions = cloud.positionData();
+  const std::size_t n = cloud.size();
+  ASSERT_GT(n, 7000u);
+  for (const float radius : {0.03f, 0.1f, 0.4f}) {
+    cvo::VoxelGrid grid;
+    grid.build(positions.data(), n, radius);
+    std::size_t pairs = 0;
+    for (std::size_t q = 0; q < n; q += 37) {
+      // Queries at the cloud's points and just off them (between cells).
+      const float p[3] = {positions[3 * q] + 0.3f * radius, positions[3 * q + 1],
+                          positions[3 * q + 2] - 0.2f * radius};
+      std::multiset<std::uint32_t> found;
+      grid.forEachWithin(p, radius, [&](std::uint32_t i, float) { found.insert(i); });
+      std::multiset<std::uint32_t> expected;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float dx = positions[3 * i] - p[0], dy = positions[3 * i + 1] - p[1],
+                    dz = positions[3 * i + 2] - p[2];
+        if (dx * dx + dy * dy + dz * dz <= radius * radius) {
+          expected.insert(static_cast<std::uint32_t>(i));
+        }
+      }
+      ASSERT_EQ(found, expected) << "radius " << radius << ", query " << q;
+      pairs += found.size();
+    }
+    EXPECT_GT(pairs, n / 37) << "the queries found neighbours at radius " << radius;
+  }
+}
+
+TEST(DenseGrid, EveryPointOfTheBoxHasACell) {
+  // A box whose far face lies exactly on a cell boundary: rounding must not leave the grid.
+  const cvo::kernels::DenseGridShape shape{{-1.0f, 0.0f, 0.5f}, 0.1f, {20, 10, 30}};
+  const float corners[][3] = {{-1.0f, 0.0f, 0.5f}, {1.0f, 1.0f, 3.5f}, {0.99999f, 0.5f, 3.5f}};
+  const unsigned long long cells = 20ull * 10 * 30;
+  for (const auto& p : corners)
+    EXPECT_LT(cvo::kernels::cellOfPoint(shape, p), cells);
+  EXPECT_EQ(cvo::kernels::cellOfPoint(shape, corners[0]), 0u);
+  EXPECT_EQ(cvo::kernels::cellOfPoint(shape, corners[1]), cells - 1);
+  // The ranges visited around a far-away point: none.
+  std::vector<unsigned> start(cells + 1, 0);
+  const float far[3] = {50.0f, 50.0f, 50.0f};
+  int ranges = 0;
+  cvo::kernels::forEachNeighbourRange(shape, start.data(), far,
+                                      [&](unsigned, unsigned) { ++ranges; });
+  EXPECT_EQ(ranges, 0);
+  const float inside[3] = {0.05f, 0.55f, 2.0f};
+  cvo::kernels::forEachNeighbourRange(shape, start.data(), inside,
+                                      [&](unsigned, unsigned) { ++ranges; });
+  EXPECT_EQ(ranges, 9);
+}
+
+}  // namespace
