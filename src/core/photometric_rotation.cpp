@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kHuberScale = 1.345;  // 95% efficiency under Gaussian residuals
 constexpr double kMadToSigma = 1.4826;
-constexpr double kStepTolerance = 1e-7;
+constexpr double kStepTolerance = 1e-4;
 // Below this correlation of the current intensities with the reference's at the result the two
 // images do not show the same scene (a covered lens, a black frame): the rotation is not taken.
 constexpr double kMinCorrelation = 0.5;
