@@ -72,16 +72,6 @@ void CpuBackend::Block::resize(std::size_t n) {
   target.resize(n);
 }
 
-void CpuBackend::Block::push(std::uint32_t index, const float* position, float weight,
-                             float distance2) {
-  target.push_back(index);
-  x.push_back(position[0]);
-  y.push_back(position[1]);
-  z.push_back(position[2]);
-  appearance.push_back(weight);
-  appearance_d2.push_back(distance2);
-}
-
 void CpuBackend::Block::move(std::size_t from, std::size_t to) {
   target[to] = target[from];
   x[to] = x[from];
@@ -116,10 +106,14 @@ double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
   return lie::rotationAngle(relative.linear()) * built_radius_ + relative.translation().norm();
 }
 
+bool CpuBackend::candidatesHold(const Eigen::Isometry3d& T, double ell) const {
+  return candidates_valid_ && ell == built_ell_ && movedSinceBuild(T) < margin_ * ell;
+}
+
 void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
+  if (candidatesHold(T, ell)) return;
   if (candidates_valid_) {
     const double moved = movedSinceBuild(T);
-    if (ell == built_ell_ && moved < margin_ * ell) return;
     if (ell < built_ell_) {
       const double margin = margin_ - moved / built_ell_;
       if (margin >= kMinMargin) {
@@ -251,6 +245,54 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
       const kernels::PointSums sums =
           sumCandidates(xs, ys, zs, constant ? nullptr : appearance, constant_appearance, count, z,
                         inv_two_ell2, sp_thres);
+      if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
+    }
+  }
+  kernels::MomentSums total;
+  kernels::clear(total);
+  for (const auto& m : partial)
+    kernels::add(total, m);
+  return total;
+}
+
+kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
+  if (candidatesHold(T, ell)) return moments(T, ell);
+  // Only pairs within the cut-off can be retained: the grid at that radius, no skin.
+  const float radius = static_cast<float>(std::sqrt(cutoff2_) * ell);
+  grid_.build(target_->positionData().data(), target_->size(), radius);
+  float pose[12];
+  toRowMajor3x4(T, pose);
+  const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+  const float* src = source_->positionData().data();
+  const bool color = constants_.use_color;
+  const bool semantic = constants_.semantic_classes > 0;
+  const long block_count = static_cast<long>(blocks_.size());
+  std::vector<kernels::MomentSums> partial(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
+  for (long b = 0; b < block_count; ++b) {
+    kernels::MomentSums& m = partial[b];
+    kernels::clear(m);
+    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    const std::size_t end = std::min(begin + kBlockSize, source_->size());
+    for (std::size_t j = begin; j < end; ++j) {
+      float z[3];
+      kernels::transformPoint(pose, src + 3 * j, z);
+      kernels::PointSums sums;
+      kernels::clear(sums);
+      grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
+        const float* x = target_->positionData().data() + 3 * i;
+        const float appearance =
+            color || semantic ? kernels::appearanceWeight(
+                                    constants_, kernels::appearanceDistance2(
+                                                    constants_, color ? target_->color(i) : nullptr,
+                                                    color ? source_->color(j) : nullptr,
+                                                    semantic ? target_->semantics(i) : nullptr,
+                                                    semantic ? source_->semantics(j) : nullptr))
+                              : constants_.max_weight;
+        const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1],
+                                                    x[2] - z[2], inv_two_ell2, constants_.sp_thres);
+        kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
+      });
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
   }

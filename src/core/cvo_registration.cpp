@@ -83,7 +83,7 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   const double norm = std::sqrt(static_cast<double>(target.size()) * source.size());
   report.indicator_after =
       backend_->moments(result.transform, report.final_lengthscale).weight / norm;
-  report.indicator_before = backend_->moments(guess, report.final_lengthscale).weight / norm;
+  report.indicator_before = backend_->oneOffMoments(guess, report.final_lengthscale).weight / norm;
   if (failover && failover->failedOver()) {
     report.backend = failover->name();
     report.warning = "GPU failed, this registration ran on the CPU: " + failover->lastError();
@@ -228,7 +228,7 @@ double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCl
                                      const Eigen::Isometry3d& T, double ell) {
   checkInputs(target, source);
   backend_->setProblem(target, source, params_);
-  return backend_->moments(T, ell).weight;
+  return backend_->oneOffMoments(T, ell).weight;
 }
 
 double CvoRegistration::indicator(const LabeledCloud& target, const LabeledCloud& source,

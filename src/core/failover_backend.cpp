@@ -54,6 +54,10 @@ kernels::MomentSums FailoverBackend::moments(const Eigen::Isometry3d& T, double 
   return run([&](RegistrationBackend& b) { return b.moments(T, ell); });
 }
 
+kernels::MomentSums FailoverBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
+  return run([&](RegistrationBackend& b) { return b.oneOffMoments(T, ell); });
+}
+
 kernels::TaylorSums FailoverBackend::taylor(const Eigen::Isometry3d& T, const Vector6d& xi,
                                             double ell) {
   return run([&](RegistrationBackend& b) { return b.taylor(T, xi, ell); });

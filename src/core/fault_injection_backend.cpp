@@ -29,6 +29,11 @@ kernels::MomentSums FaultInjectionBackend::moments(const Eigen::Isometry3d& T, d
   return inner_->moments(T, ell);
 }
 
+kernels::MomentSums FaultInjectionBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
+  countCall();
+  return inner_->oneOffMoments(T, ell);
+}
+
 kernels::TaylorSums FaultInjectionBackend::taylor(const Eigen::Isometry3d& T, const Vector6d& xi,
                                                   double ell) {
   countCall();

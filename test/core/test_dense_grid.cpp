@@ -1,6 +1,6 @@
 // The dense neighbour grid (dense_grid.hpp), whose arithmetic the CPU VoxelGrid and the CUDA
 // kernels share: on a real TUM cloud every point within the radius is found, exactly once, and
-// every point lands in a cell of the box.
+// every point lands in a cell of the box; and the CPU backend's one-off evaluation from the grid.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cvo_odometry/core/cloud_io.hpp"
+#include "cvo_odometry/core/cpu_backend.hpp"
 #include "cvo_odometry/core/dense_grid.hpp"
 #include "cvo_odometry/core/voxel_grid.hpp"
 
@@ -66,6 +67,43 @@ TEST(DenseGrid, EveryPointOfTheBoxHasACell) {
   cvo::kernels::forEachNeighbourRange(shape, start.data(), inside,
                                       [&](unsigned, unsigned) { ++ranges; });
   EXPECT_EQ(ranges, 9);
+}
+
+}  // namespace
+
+namespace {
+
+// The one-off evaluation (straight from the grid) against the candidate lists, on real clouds:
+// the same sums up to float rounding, with and without colour, at poses the lists were not
+// built for.
+TEST(CpuBackendOneOff, MatchesTheCandidateLists) {
+  const cvo::LabeledCloud target =
+      cvo::readCloud(std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_3000.cloud");
+  const cvo::LabeledCloud source =
+      cvo::readCloud(std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame11_3000.cloud");
+  for (const bool color : {false, true}) {
+    cvo::CvoParams params;
+    params.use_color = color;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() << 0.01, -0.005, 0.008;
+    T.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    for (const double ell : {0.05, 0.1}) {
+      cvo::CpuBackend lists(2), one_off(2);
+      lists.setProblem(target, source, params);
+      one_off.setProblem(target, source, params);
+      const cvo::kernels::MomentSums a = lists.moments(T, ell);
+      const cvo::kernels::MomentSums b = one_off.oneOffMoments(T, ell);
+      ASSERT_GT(a.pairs, 500u) << "color " << color << ", ell " << ell;
+      EXPECT_EQ(a.pairs, b.pairs);
+      EXPECT_NEAR(b.weight, a.weight, 1e-5 * a.weight);
+      for (int k = 0; k < 9; ++k) {
+        EXPECT_NEAR(b.cross[k], a.cross[k], 1e-5 * a.weight) << "cross " << k;
+      }
+      // With the lists built at T, a one-off evaluation near T reads them: identical sums.
+      const cvo::kernels::MomentSums c = lists.oneOffMoments(T, ell);
+      EXPECT_EQ(c.weight, a.weight);
+    }
+  }
 }
 
 }  // namespace

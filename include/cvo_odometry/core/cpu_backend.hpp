@@ -21,6 +21,8 @@ class CpuBackend : public RegistrationBackend {
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
+  // From the candidate lists when they hold the pose, else straight from the grid (no lists).
+  kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
 
  private:
@@ -33,12 +35,21 @@ class CpuBackend : public RegistrationBackend {
     std::vector<float> appearance_d2;  // scaled appearance distance (pose independent)
 
     void clear();
-    void push(std::uint32_t index, const float* position, float weight, float distance2);
+    void push(std::uint32_t index, const float* position, float weight, float distance2) {
+      target.push_back(index);
+      x.push_back(position[0]);
+      y.push_back(position[1]);
+      z.push_back(position[2]);
+      appearance.push_back(weight);
+      appearance_d2.push_back(distance2);
+    }
     // Keeps candidate `from` at slot `to` (to <= from).
     void move(std::size_t from, std::size_t to);
     void resize(std::size_t n);
   };
 
+  // True when the lists built at built_pose_ / built_ell_ still hold every pair at (T, ell).
+  bool candidatesHold(const Eigen::Isometry3d& T, double ell) const;
   void ensureCandidates(const Eigen::Isometry3d& T, double ell);
   // Candidates from the grid, kept when the scaled joint distance < sqrt(cutoff) + margin.
   void buildCandidates(const Eigen::Isometry3d& T, double ell);

@@ -26,6 +26,11 @@ class RegistrationBackend {
                           const CvoParams& params) = 0;
   // Sums over the retained pairs (x_i, T z_j) at lengthscale `ell`.
   virtual kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) = 0;
+  // The same sums at a pose that the following calls will not come back near (an indicator at
+  // the initial guess, a self product): a backend need not build what it would reuse.
+  virtual kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) {
+    return moments(T, ell);
+  }
   // Taylor coefficients of F(exp(t xi) T) in t, over the pairs retained at T.
   virtual kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi,
                                      double ell) = 0;
