@@ -135,8 +135,6 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   const float reach2 = static_cast<float>(reach * reach);
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
-  const bool color = constants_.use_color;
-  const bool semantic = constants_.semantic_classes > 0;
   const long block_count = static_cast<long>(blocks_.size());
   double radius_max = 0.0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount()) reduction(max : radius_max)
@@ -151,17 +149,14 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
       kernels::transformPoint(pose, src + 3 * j, z);
       radius_max = std::max(
           radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
-      if (!color && !semantic) {
+      if (constant_appearance_) {
         // Geometry only: the grid's radius test is the joint-distance test.
         grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
           block.push(i, tgt + 3 * i, constants_.max_weight, 0.0f);
         });
       } else {
         grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
-          const float appearance_d2 = kernels::appearanceDistance2(
-              constants_, color ? target_->color(i) : nullptr, color ? source_->color(j) : nullptr,
-              semantic ? target_->semantics(i) : nullptr,
-              semantic ? source_->semantics(j) : nullptr);
+          const float appearance_d2 = appearanceDistance2(i, j);
           if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
           block.push(i, tgt + 3 * i, kernels::appearanceWeight(constants_, appearance_d2),
                      appearance_d2);
@@ -215,6 +210,29 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
   built_radius_ = radius_max;
 }
 
+template <class Fill>
+kernels::MomentSums CpuBackend::sumBlocks(Fill&& fill) const {
+  const long block_count = static_cast<long>(blocks_.size());
+  std::vector<kernels::MomentSums> partial(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
+  for (long b = 0; b < block_count; ++b) {
+    kernels::clear(partial[b]);
+    fill(static_cast<std::size_t>(b), partial[b]);
+  }
+  kernels::MomentSums total;
+  kernels::clear(total);
+  for (const auto& m : partial)
+    kernels::add(total, m);
+  return total;
+}
+
+float CpuBackend::appearanceDistance2(std::uint32_t i, std::size_t j) const {
+  const bool color = constants_.use_color, semantic = constants_.semantic_classes > 0;
+  return kernels::appearanceDistance2(
+      constants_, color ? target_->color(i) : nullptr, color ? source_->color(j) : nullptr,
+      semantic ? target_->semantics(i) : nullptr, semantic ? source_->semantics(j) : nullptr);
+}
+
 kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) {
   ensureCandidates(T, ell);
   float pose[12];
@@ -224,14 +242,9 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
   const float constant_appearance = constants_.max_weight;
   const bool constant = constant_appearance_;
   const float* src = source_->positionData().data();
-  const long block_count = static_cast<long>(blocks_.size());
-  std::vector<kernels::MomentSums> partial(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
-  for (long b = 0; b < block_count; ++b) {
+  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
     const Block& block = blocks_[b];
-    kernels::MomentSums& m = partial[b];
-    kernels::clear(m);
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    const std::size_t begin = b * kBlockSize;
     const std::size_t points = block.offsets.size() - 1;
     for (std::size_t k = 0; k < points; ++k) {
       float z[3];
@@ -247,12 +260,7 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
                         inv_two_ell2, sp_thres);
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
-  }
-  kernels::MomentSums total;
-  kernels::clear(total);
-  for (const auto& m : partial)
-    kernels::add(total, m);
-  return total;
+  });
 }
 
 kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
@@ -263,16 +271,11 @@ kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+  const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
-  const bool color = constants_.use_color;
-  const bool semantic = constants_.semantic_classes > 0;
-  const long block_count = static_cast<long>(blocks_.size());
-  std::vector<kernels::MomentSums> partial(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
-  for (long b = 0; b < block_count; ++b) {
-    kernels::MomentSums& m = partial[b];
-    kernels::clear(m);
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+  const bool constant = constant_appearance_;
+  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
+    const std::size_t begin = b * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
     for (std::size_t j = begin; j < end; ++j) {
       float z[3];
@@ -280,27 +283,17 @@ kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double
       kernels::PointSums sums;
       kernels::clear(sums);
       grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
-        const float* x = target_->positionData().data() + 3 * i;
+        const float* x = tgt + 3 * i;
         const float appearance =
-            color || semantic ? kernels::appearanceWeight(
-                                    constants_, kernels::appearanceDistance2(
-                                                    constants_, color ? target_->color(i) : nullptr,
-                                                    color ? source_->color(j) : nullptr,
-                                                    semantic ? target_->semantics(i) : nullptr,
-                                                    semantic ? source_->semantics(j) : nullptr))
-                              : constants_.max_weight;
+            constant ? constants_.max_weight
+                     : kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
         const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1],
                                                     x[2] - z[2], inv_two_ell2, constants_.sp_thres);
         kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
       });
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
-  }
-  kernels::MomentSums total;
-  kernels::clear(total);
-  for (const auto& m : partial)
-    kernels::add(total, m);
-  return total;
+  });
 }
 
 kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) {

@@ -57,6 +57,11 @@ class CpuBackend : public RegistrationBackend {
   // is a filter of the old one, with the old margin less what the source moved since.
   void refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin);
   double movedSinceBuild(const Eigen::Isometry3d& T) const;
+  // Scaled appearance distance of target point i and source point j (colour, semantics).
+  float appearanceDistance2(std::uint32_t i, std::size_t j) const;
+  // Moments of every block of source points, fill(block, sums), added in block order.
+  template <class Fill>
+  kernels::MomentSums sumBlocks(Fill&& fill) const;
   int threadCount() const;
 
   int num_threads_;
