@@ -61,9 +61,7 @@ void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
       "segmentation/image", queue,
       boost::function<void(const ImagePtr&)>([this](const ImagePtr& labels) {
         std::lock_guard<std::mutex> lock(mutex_);
-        for (auto& frame : with_labels_->addSecond(labels->header.stamp.toSec(), labels)) {
-          callback_(frame.first.first, frame.first.second, frame.second);
-        }
+        onLabelledFrames(with_labels_->addSecond(labels->header.stamp.toSec(), labels));
       }),
       ros::VoidPtr(), hints));
 }
@@ -76,10 +74,14 @@ void RgbdTopicSync::onPairs(
       callback_(pair.first, pair.second, nullptr);
       continue;
     }
-    for (auto& frame : with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second})) {
-      callback_(frame.first.first, frame.first.second, frame.second);
-    }
+    onLabelledFrames(with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second}));
   }
+}
+
+void RgbdTopicSync::onLabelledFrames(
+    const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames) {
+  for (const auto& frame : frames)
+    callback_(frame.first.first, frame.first.second, frame.second);
 }
 
 void RgbdTopicSync::subscribeFilters(image_transport::ImageTransport& it,

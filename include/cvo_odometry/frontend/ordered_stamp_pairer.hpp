@@ -184,7 +184,7 @@ class OrderedStampPairer {
   std::vector<Pair> drain() {
     std::vector<Pair> pairs;
     if (!offset_ && !learn()) {
-      trimUnlearned();
+      trimQueues();
       return pairs;
     }
     const double spacing = secondSpacing();
@@ -223,15 +223,13 @@ class OrderedStampPairer {
       seconds_.erase(seconds_.begin(), seconds_.begin() + static_cast<std::ptrdiff_t>(best) + 1);
       updateOffset(pairs.back().second_stamp - pairs.back().first_stamp);
     }
-    while (seconds_.size() > options_.queue_size) {
-      seconds_.pop_front();
-      ++dropped_second_;
-    }
+    trimQueues();
     return pairs;
   }
 
-  // Before the offset is known (one stream silent) the queues keep the latest messages.
-  void trimUnlearned() {
+  // Each queue keeps its latest queue_size messages (a silent partner stream, an unlearned
+  // offset); older ones are given up.
+  void trimQueues() {
     while (firsts_.size() > options_.queue_size) {
       firsts_.pop_front();
       ++dropped_first_;

@@ -54,6 +54,7 @@ class RgbdTopicSync {
   void subscribeFilters(image_transport::ImageTransport& it,
                         const image_transport::TransportHints& hints);
   void onPairs(const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs);
+  void onLabelledFrames(const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames);
   void onSynchronized(const ImagePtr& image, const ImagePtr& depth) {
     callback_(image, depth, nullptr);
   }

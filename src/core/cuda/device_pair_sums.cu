@@ -208,7 +208,7 @@ struct DevicePairSums::Impl {
   kernels::TaylorSums* pinned_taylor = nullptr;
   int count[2] = {0, 0};
   int classes = 0;
-  bool has_color[2] = {false, false};
+  bool target_has_color = false;
   std::vector<float> host_positions;  // target positions, for the bounding box
   kernels::KernelConstants constants{};
   double cutoff2 = 0.0;
@@ -299,8 +299,8 @@ struct DevicePairSums::Impl {
             "sort");
       const int blocks = (n + kThreads - 1) / kThreads;
       gatherKernel<<<blocks, kThreads, 0, stream>>>(
-          order.data, n, raw[0][0].data, has_color[0] ? raw[0][1].data : nullptr, raw[0][2].data,
-          classes, sorted[0].data, sorted[1].data, sorted[2].data);
+          order.data, n, raw[0][0].data, target_has_color ? raw[0][1].data : nullptr,
+          raw[0][2].data, classes, sorted[0].data, sorted[1].data, sorted[2].data);
       check(cudaGetLastError(), "gather kernel");
     }
     grid.start = start.data;
@@ -368,7 +368,7 @@ void DevicePairSums::setCloud(bool target, const float* positions, const float* 
   const int which = target ? 0 : 1;
   d.count[which] = count;
   d.classes = classes;
-  d.has_color[which] = colors != nullptr;
+  if (target) d.target_has_color = colors != nullptr;
   const auto n = static_cast<std::size_t>(count);
   const float* data[3] = {positions, colors, semantics};
   const std::size_t sizes[3] = {3 * n, colors ? kernels::kColorDim * n : 0,
