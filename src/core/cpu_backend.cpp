@@ -89,6 +89,9 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
   constant_appearance_ = !constants_.use_color && constants_.semantic_classes == 0;
   cutoff2_ = retainedScaledDistance2(params);
   candidates_valid_ = false;
+  direct_ell_ = -1.0;
+  ell_min_ = params.ell_min;
+  grid_radius_ = -1.0f;
   // Blocks keep their storage across problems: no reallocation (and page faults) per level.
   blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
 }
@@ -128,7 +131,7 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
 void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   const double reach = std::sqrt(cutoff2_) + kSkin;  // scaled joint distance kept
   const float radius = static_cast<float>(reach * ell);
-  grid_.build(target_->positionData().data(), target_->size(), radius);
+  ensureGrid(radius);
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
@@ -233,7 +236,20 @@ float CpuBackend::appearanceDistance2(std::uint32_t i, std::size_t j) const {
       semantic ? target_->semantics(i) : nullptr, semantic ? source_->semantics(j) : nullptr);
 }
 
+void CpuBackend::ensureGrid(float radius) {
+  if (radius == grid_radius_) return;
+  grid_.build(target_->positionData().data(), target_->size(), radius);
+  grid_radius_ = radius;
+}
+
 kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) {
+  if (constant_appearance_ && ell > ell_min_ && ell != direct_ell_ && !candidatesHold(T, ell)) {
+    // Geometry only, a coarse level's first evaluation (often its only one): reading the grid
+    // costs less than building lists that may not be used again. At ell_min, where the
+    // registration iterates to convergence, the lists pay off at once.
+    direct_ell_ = ell;
+    return gridMoments(T, ell);
+  }
   ensureCandidates(T, ell);
   float pose[12];
   toRowMajor3x4(T, pose);
@@ -263,17 +279,50 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
   });
 }
 
+kernels::MomentSums CpuBackend::gridMoments(const Eigen::Isometry3d& T, double ell) {
+  // Only pairs within the cut-off can be retained: the grid at that radius, no skin; pairs
+  // beyond it in the ranges weigh 0 in the pair loop.
+  const float radius = static_cast<float>(std::sqrt(cutoff2_) * ell);
+  ensureGrid(radius);
+  float pose[12];
+  toRowMajor3x4(T, pose);
+  const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+  const float* src = source_->positionData().data();
+  const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
+  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
+    // A point's ranges copied into one run: one vectorised loop a point, not one a range.
+    std::vector<float> run_x, run_y, run_z;
+    const std::size_t begin = b * kBlockSize;
+    const std::size_t end = std::min(begin + kBlockSize, source_->size());
+    for (std::size_t j = begin; j < end; ++j) {
+      float z[3];
+      kernels::transformPoint(pose, src + 3 * j, z);
+      run_x.clear();
+      run_y.clear();
+      run_z.clear();
+      grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+        run_x.insert(run_x.end(), xs + first, xs + last);
+        run_y.insert(run_y.end(), ys + first, ys + last);
+        run_z.insert(run_z.end(), zs + first, zs + last);
+      });
+      const kernels::PointSums sums =
+          sumCandidates(run_x.data(), run_y.data(), run_z.data(), nullptr, constants_.max_weight,
+                        static_cast<int>(run_x.size()), z, inv_two_ell2, constants_.sp_thres);
+      if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
+    }
+  });
+}
+
 kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
   if (candidatesHold(T, ell)) return moments(T, ell);
-  // Only pairs within the cut-off can be retained: the grid at that radius, no skin.
+  if (constant_appearance_) return gridMoments(T, ell);
   const float radius = static_cast<float>(std::sqrt(cutoff2_) * ell);
-  grid_.build(target_->positionData().data(), target_->size(), radius);
+  ensureGrid(radius);
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
-  const bool constant = constant_appearance_;
   return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
     const std::size_t begin = b * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
@@ -284,9 +333,7 @@ kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double
       kernels::clear(sums);
       grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
         const float* x = tgt + 3 * i;
-        const float appearance =
-            constant ? constants_.max_weight
-                     : kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
+        const float appearance = kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
         const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1],
                                                     x[2] - z[2], inv_two_ell2, constants_.sp_thres);
         kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);

@@ -75,11 +75,15 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
     }
     start_.clear();
   }
-  sorted_storage_.resize(3 * count);
+  xs_.resize(count);
+  ys_.resize(count);
+  zs_.resize(count);
   for (std::size_t k = 0; k < count; ++k) {
-    std::copy(positions + 3 * order_[k], positions + 3 * order_[k] + 3, &sorted_storage_[3 * k]);
+    const float* p = positions + 3 * order_[k];
+    xs_[k] = p[0];
+    ys_[k] = p[1];
+    zs_[k] = p[2];
   }
-  sorted_ = sorted_storage_.data();
 }
 
 }  // namespace cvo

@@ -1,9 +1,10 @@
 // The dense neighbour grid (dense_grid.hpp), whose arithmetic the CPU VoxelGrid and the CUDA
 // kernels share: on a real TUM cloud every point within the radius is found, exactly once, and
-// every point lands in a cell of the box; and the CPU backend's one-off evaluation from the grid.
+// every point lands in a cell of the box; and the CPU backend's sums read from the grid.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 #include <vector>
@@ -17,33 +18,49 @@ namespace {
 
 const std::string kCloud = std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_8000.cloud";
 
+// Every point within `radius` of queries at (and just off) the cloud's points, exactly once.
+void expectExactNeighbours(const std::vector<float>& positions, std::size_t n, float cell,
+                           float radius) {
+  cvo::VoxelGrid grid;
+  grid.build(positions.data(), n, cell);
+  std::size_t pairs = 0;
+  for (std::size_t q = 0; q < n; q += 37) {
+    const float p[3] = {positions[3 * q] + 0.3f * radius, positions[3 * q + 1],
+                        positions[3 * q + 2] - 0.2f * radius};
+    std::multiset<std::uint32_t> found;
+    grid.forEachWithin(p, radius, [&](std::uint32_t i, float) { found.insert(i); });
+    std::multiset<std::uint32_t> expected;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float dx = positions[3 * i] - p[0], dy = positions[3 * i + 1] - p[1],
+                  dz = positions[3 * i + 2] - p[2];
+      if (dx * dx + dy * dy + dz * dz <= radius * radius) {
+        expected.insert(static_cast<std::uint32_t>(i));
+      }
+    }
+    ASSERT_EQ(found, expected) << "cell " << cell << ", radius " << radius << ", query " << q;
+    pairs += found.size();
+  }
+  EXPECT_GT(pairs, n / 37) << "the queries found neighbours at radius " << radius;
+}
+
 TEST(DenseGrid, FindsExactlyTheNeighboursWithinTheRadius) {
   const cvo::LabeledCloud cloud = cvo::readCloud(kCloud);
-  const std::vector<float>& positions = cloud.positionData();
-  const std::size_t n = cloud.size();
-  ASSERT_GT(n, 7000u);
+  ASSERT_GT(cloud.size(), 7000u);
   for (const float radius : {0.03f, 0.1f, 0.4f}) {
-    cvo::VoxelGrid grid;
-    grid.build(positions.data(), n, radius);
-    std::size_t pairs = 0;
-    for (std::size_t q = 0; q < n; q += 37) {
-      // Queries at the cloud's points and just off them (between cells).
-      const float p[3] = {positions[3 * q] + 0.3f * radius, positions[3 * q + 1],
-                          positions[3 * q + 2] - 0.2f * radius};
-      std::multiset<std::uint32_t> found;
-      grid.forEachWithin(p, radius, [&](std::uint32_t i, float) { found.insert(i); });
-      std::multiset<std::uint32_t> expected;
-      for (std::size_t i = 0; i < n; ++i) {
-        const float dx = positions[3 * i] - p[0], dy = positions[3 * i + 1] - p[1],
-                    dz = positions[3 * i + 2] - p[2];
-        if (dx * dx + dy * dy + dz * dz <= radius * radius) {
-          expected.insert(static_cast<std::uint32_t>(i));
-        }
-      }
-      ASSERT_EQ(found, expected) << "radius " << radius << ", query " << q;
-      pairs += found.size();
+    // The cell as large as the radius, and smaller: the ball then spans several cells.
+    for (const float cells_per_radius : {1.0f, 2.0f, 3.0f}) {
+      expectExactNeighbours(cloud.positionData(), cloud.size(), radius / cells_per_radius, radius);
     }
-    EXPECT_GT(pairs, n / 37) << "the queries found neighbours at radius " << radius;
+  }
+}
+
+TEST(DenseGrid, FindsTheNeighboursInAHashedGridToo) {
+  // A point 5 km away makes the box too large for dense cells: the hash map serves instead.
+  const cvo::LabeledCloud cloud = cvo::readCloud(kCloud);
+  std::vector<float> positions = cloud.positionData();
+  positions.insert(positions.end(), {5000.0f, -20.0f, 3000.0f});
+  for (const float cells_per_radius : {1.0f, 2.0f}) {
+    expectExactNeighbours(positions, cloud.size() + 1, 0.05f / cells_per_radius, 0.05f);
   }
 }
 
@@ -56,27 +73,44 @@ TEST(DenseGrid, EveryPointOfTheBoxHasACell) {
     EXPECT_LT(cvo::kernels::cellOfPoint(shape, p), cells);
   EXPECT_EQ(cvo::kernels::cellOfPoint(shape, corners[0]), 0u);
   EXPECT_EQ(cvo::kernels::cellOfPoint(shape, corners[1]), cells - 1);
-  // The ranges visited around a far-away point: none.
+  // The ranges visited around far-away and non-finite points: none.
   std::vector<unsigned> start(cells + 1, 0);
-  const float far[3] = {50.0f, 50.0f, 50.0f};
+  const float far[][3] = {{50.0f, 50.0f, 50.0f},
+                          {-3e38f, 0.5f, 2.0f},
+                          {0.5f, 1e38f, 2.0f},
+                          {NAN, 0.5f, 2.0f},
+                          {0.05f, 0.55f, INFINITY}};
   int ranges = 0;
-  cvo::kernels::forEachNeighbourRange(shape, start.data(), far,
-                                      [&](unsigned, unsigned) { ++ranges; });
+  for (const auto& p : far) {
+    cvo::kernels::forEachRangeWithin(shape, start.data(), p, 0.1f,
+                                     [&](unsigned, unsigned) { ++ranges; });
+  }
   EXPECT_EQ(ranges, 0);
+  // Inside, a radius of one cell: at most the 3 x 3 columns around the point's own.
   const float inside[3] = {0.05f, 0.55f, 2.0f};
-  cvo::kernels::forEachNeighbourRange(shape, start.data(), inside,
-                                      [&](unsigned, unsigned) { ++ranges; });
-  EXPECT_EQ(ranges, 9);
+  cvo::kernels::forEachRangeWithin(shape, start.data(), inside, 0.1f,
+                                   [&](unsigned, unsigned) { ++ranges; });
+  EXPECT_GE(ranges, 1);
+  EXPECT_LE(ranges, 9);
 }
 
 }  // namespace
 
 namespace {
 
-// The one-off evaluation (straight from the grid) against the candidate lists, on real clouds:
-// the same sums up to float rounding, with and without colour, at poses the lists were not
-// built for.
-TEST(CpuBackendOneOff, MatchesTheCandidateLists) {
+// The evaluations straight from the grid (one-off, and a coarse level's first evaluation with
+// geometry only) against the candidate lists, on real clouds: the same sums up to float
+// rounding, with and without colour, at poses the lists were not built for.
+void expectSameSums(const cvo::kernels::MomentSums& a, const cvo::kernels::MomentSums& b,
+                    const std::string& what) {
+  EXPECT_EQ(a.pairs, b.pairs) << what;
+  EXPECT_NEAR(b.weight, a.weight, 1e-5 * a.weight) << what;
+  for (int k = 0; k < 9; ++k) {
+    EXPECT_NEAR(b.cross[k], a.cross[k], 1e-5 * a.weight) << what << ", cross " << k;
+  }
+}
+
+TEST(CpuBackendGridSums, MatchTheCandidateLists) {
   const cvo::LabeledCloud target =
       cvo::readCloud(std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_3000.cloud");
   const cvo::LabeledCloud source =
@@ -84,24 +118,26 @@ TEST(CpuBackendOneOff, MatchesTheCandidateLists) {
   for (const bool color : {false, true}) {
     cvo::CvoParams params;
     params.use_color = color;
+    params.ell_min = 0.05;
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.translation() << 0.01, -0.005, 0.008;
     T.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()).toRotationMatrix();
     for (const double ell : {0.05, 0.1}) {
+      const std::string what =
+          std::string(color ? "colour" : "geometry") + ", ell " + std::to_string(ell);
       cvo::CpuBackend lists(2), one_off(2);
       lists.setProblem(target, source, params);
       one_off.setProblem(target, source, params);
+      // Above ell_min with geometry only, the first evaluation reads the grid, the second the
+      // lists it then builds.
+      const cvo::kernels::MomentSums first = lists.moments(T, ell);
       const cvo::kernels::MomentSums a = lists.moments(T, ell);
-      const cvo::kernels::MomentSums b = one_off.oneOffMoments(T, ell);
-      ASSERT_GT(a.pairs, 500u) << "color " << color << ", ell " << ell;
-      EXPECT_EQ(a.pairs, b.pairs);
-      EXPECT_NEAR(b.weight, a.weight, 1e-5 * a.weight);
-      for (int k = 0; k < 9; ++k) {
-        EXPECT_NEAR(b.cross[k], a.cross[k], 1e-5 * a.weight) << "cross " << k;
-      }
+      ASSERT_GT(a.pairs, 500u) << what;
+      expectSameSums(a, first, what + ", first evaluation");
+      expectSameSums(a, one_off.oneOffMoments(T, ell), what + ", one-off");
       // With the lists built at T, a one-off evaluation near T reads them: identical sums.
       const cvo::kernels::MomentSums c = lists.oneOffMoments(T, ell);
-      EXPECT_EQ(c.weight, a.weight);
+      EXPECT_EQ(c.weight, a.weight) << what;
     }
   }
 }

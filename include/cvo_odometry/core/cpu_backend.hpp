@@ -57,6 +57,10 @@ class CpuBackend : public RegistrationBackend {
   // is a filter of the old one, with the old margin less what the source moved since.
   void refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin);
   double movedSinceBuild(const Eigen::Isometry3d& T) const;
+  // The target's grid with this cell size (kept while the problem and size stay).
+  void ensureGrid(float radius);
+  // Geometry only: the moments read straight from the grid's sorted ranges (no lists).
+  kernels::MomentSums gridMoments(const Eigen::Isometry3d& T, double ell);
   // Scaled appearance distance of target point i and source point j (colour, semantics).
   float appearanceDistance2(std::uint32_t i, std::size_t j) const;
   // Moments of every block of source points, fill(block, sums), added in block order.
@@ -71,6 +75,9 @@ class CpuBackend : public RegistrationBackend {
   bool constant_appearance_ = true;  // geometry only: every pair's appearance is s^2
   double cutoff2_ = 0.0;             // retained iff scaled joint distance^2 below this
   VoxelGrid grid_;
+  float grid_radius_ = -1.0f;  // the cell size grid_ was built with, -1: none for this problem
+  double direct_ell_ = -1.0;   // lengthscale of the last evaluation read from the grid
+  double ell_min_ = 0.0;
   std::vector<Block> blocks_;
   bool candidates_valid_ = false;
   double built_ell_ = 0.0;

@@ -1,6 +1,6 @@
 // The arithmetic of the dense neighbour grid, written once for the CPU VoxelGrid and the CUDA
 // kernels: the target sorted by cell, the z cells of one (x, y) column contiguous, so that the
-// candidates within one cell of a point lie in 9 index ranges of the sorted order.
+// candidates within a radius of a point lie in a few index ranges of the sorted order.
 #pragma once
 
 #include <math.h>
@@ -34,22 +34,42 @@ CVO_HOST_DEVICE inline unsigned long long cellOfPoint(const DenseGridShape& g, c
   return flatCell(g, c[0], c[1], c[2]);
 }
 
-// Calls visit(begin, end) for the sorted-order ranges of the 9 (x, y) columns around p's cell,
-// each over the z cells p's cell and its two z neighbours span; `start` holds the first sorted
-// index of every cell and, last, the point count. Fixed order: deterministic sums.
+// A cell coordinate range [first, last] clamped to [0, dims - 1] before any float -> int
+// conversion (a far or non-finite point must not overflow the cast): empty when first > last.
+CVO_HOST_DEVICE inline void clampedCellRange(float low, float high, int dims, int& first,
+                                             int& last) {
+  const float top = static_cast<float>(dims);
+  // fmaxf/fminf return the number when the other operand is NaN: NaN ends up an empty range.
+  low = fminf(fmaxf(floorf(low), 0.0f), top);
+  high = fminf(fmaxf(floorf(high), -1.0f), top - 1.0f);
+  first = static_cast<int>(low);
+  last = static_cast<int>(high);
+}
+
+// Calls visit(begin, end) for sorted-order ranges that together hold every point within `radius`
+// of p (and some beyond): for each (x, y) column whose footprint comes within the radius, the run
+// of z cells the radius spans. Any cell size works (the radius may span several cells); `start`
+// holds the first sorted index of every cell and, last, the point count. Fixed order:
+// deterministic sums.
 template <class Visit>
-CVO_HOST_DEVICE inline void forEachNeighbourRange(const DenseGridShape& g, const unsigned* start,
-                                                  const float* p, Visit&& visit) {
-  const int cx = cellCoordinate(g, p[0], 0);
-  const int cy = cellCoordinate(g, p[1], 1);
-  const int cz = cellCoordinate(g, p[2], 2);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int x = cx + dx, y = cy + dy;
-      if (x < 0 || y < 0 || x >= g.dims[0] || y >= g.dims[1]) continue;
-      const int z0 = cz - 1 < 0 ? 0 : cz - 1;
-      const int z1 = cz + 1 > g.dims[2] - 1 ? g.dims[2] - 1 : cz + 1;
-      if (z0 > z1) continue;
+CVO_HOST_DEVICE inline void forEachRangeWithin(const DenseGridShape& g, const unsigned* start,
+                                               const float* p, float radius, Visit&& visit) {
+  // In cell units, as cellCoordinate divides; the slack covers that division's rounding.
+  const float lx = (p[0] - g.origin[0]) / g.cell, ly = (p[1] - g.origin[1]) / g.cell;
+  const float lz = (p[2] - g.origin[2]) / g.cell;
+  const float reach = radius / g.cell * 1.00001f + 1e-6f;
+  int x0, x1, y0, y1, z0, z1;
+  clampedCellRange(lx - reach, lx + reach, g.dims[0], x0, x1);
+  clampedCellRange(ly - reach, ly + reach, g.dims[1], y0, y1);
+  clampedCellRange(lz - reach, lz + reach, g.dims[2], z0, z1);
+  if (z0 > z1) return;
+  const float reach2 = reach * reach;
+  for (int x = x0; x <= x1; ++x) {
+    // Distance from p to the column's footprint along x (0 inside it).
+    const float ex = lx < x ? x - lx : (lx > x + 1 ? lx - (x + 1) : 0.0f);
+    for (int y = y0; y <= y1; ++y) {
+      const float ey = ly < y ? y - ly : (ly > y + 1 ? ly - (y + 1) : 0.0f);
+      if (ex * ex + ey * ey > reach2) continue;
       const unsigned long long column = flatCell(g, x, y, 0);
       visit(start[column + z0], start[column + z1 + 1]);
     }

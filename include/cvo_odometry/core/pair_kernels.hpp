@@ -89,6 +89,13 @@ CVO_HOST_DEVICE inline void clear(PointSums& p) {
   p.pairs = 0;
 }
 
+CVO_HOST_DEVICE inline void add(PointSums& p, const PointSums& o) {
+  p.weight += o.weight;
+  for (int k = 0; k < 3; ++k)
+    p.offset[k] += o.offset[k];
+  p.pairs += o.pairs;
+}
+
 CVO_HOST_DEVICE inline float floatFromBits(int bits) {
 #if defined(__CUDA_ARCH__)
   return __int_as_float(bits);

@@ -54,6 +54,7 @@ struct Twist {
 struct GridView {
   kernels::DenseGridShape shape;
   const unsigned int* start;  // cells + 1 offsets into the sorted target arrays
+  float radius;               // the query radius (<= the cell edge)
 };
 
 struct CloudView {
@@ -63,14 +64,14 @@ struct CloudView {
   int count;
 };
 
-// Visits the target points of the 9 z-columns around z (the grid cell is the query radius).
+// Visits the target points in the cell ranges the query ball around z reaches.
 template <class F>
 __device__ void forEachCandidate(const GridView& grid, const float* z, F&& f) {
-  kernels::forEachNeighbourRange(grid.shape, grid.start, z,
-                                 [&](unsigned int begin, unsigned int end) {
-                                   for (unsigned int k = begin; k < end; ++k)
-                                     f(k);
-                                 });
+  kernels::forEachRangeWithin(grid.shape, grid.start, z, grid.radius,
+                              [&](unsigned int begin, unsigned int end) {
+                                for (unsigned int k = begin; k < end; ++k)
+                                  f(k);
+                              });
 }
 
 __device__ float pairAppearance(const kernels::KernelConstants& k, const CloudView& target, int i,
@@ -304,6 +305,7 @@ struct DevicePairSums::Impl {
       check(cudaGetLastError(), "gather kernel");
     }
     grid.start = start.data;
+    grid.radius = static_cast<float>(cell_size);
     grid_cell = cell_size;
   }
 
