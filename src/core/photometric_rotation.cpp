@@ -7,6 +7,10 @@
 
 #include "cvo_odometry/core/lie_group.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace cvo {
 
 namespace {
@@ -26,6 +30,15 @@ double medianAbsolute(const std::vector<double>& residuals) {
   const auto middle = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
   std::nth_element(a.begin(), middle, a.end());
   return *middle;
+}
+
+int threadCount(const CvoParams& params) {
+#ifdef _OPENMP
+  return params.num_threads > 0 ? params.num_threads : omp_get_max_threads();
+#else
+  (void)params;
+  return 1;
+#endif
 }
 
 }  // namespace
@@ -56,23 +69,29 @@ PhotometricRotationResult refineRotationPhotometrically(
     points[j] = cloud.position(j).cast<double>();
 
   Eigen::Isometry3d T = reference_from_current;
-  std::vector<double> own(n), residuals, sampled_own;
+  const int threads = threadCount(params);
+  const long count = static_cast<long>(n);
+  // Per point (NaN residual: not observed), filled in parallel, then gathered in point order:
+  // the same sums whatever the thread count.
+  std::vector<double> own(n), point_residual(n);
+  std::vector<Eigen::Matrix<double, 6, 1>> point_jacobian(n);
+  std::vector<double> residuals, sampled_own;
   std::vector<Eigen::Matrix<double, 6, 1>> jacobians;
   residuals.reserve(n);
   jacobians.reserve(n);
   for (int level = 0; level < reference.levelCount(); ++level) {
     // Each point's intensity in its own image (where it was selected), at this blur.
-    for (std::size_t j = 0; j < n; ++j) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (long j = 0; j < count; ++j) {
       own[j] = NAN;
       if (!(points[j].z() > 0.0)) continue;
       const Eigen::Vector2d p = current.camera().project(points[j]);
       if (current.inside(p.x(), p.y())) own[j] = current.sample(level, p.x(), p.y()).intensity;
     }
     for (int it = 0; it < params.photometric_iterations; ++it) {
-      residuals.clear();
-      jacobians.clear();
-      sampled_own.clear();
-      for (std::size_t j = 0; j < n; ++j) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+      for (long j = 0; j < count; ++j) {
+        point_residual[j] = NAN;
         if (std::isnan(own[j])) continue;
         const Eigen::Vector3d Y = T * points[j];
         if (!(Y.z() > 0.0)) continue;
@@ -82,11 +101,17 @@ PhotometricRotationResult refineRotationPhotometrically(
         // d I / d Y, then the left perturbation Y + omega x Y + v.
         const Eigen::Vector3d dI = reference.camera().pinholeJacobian(Y).transpose() *
                                    Eigen::Vector2d(s.gradient_u, s.gradient_v);
-        Eigen::Matrix<double, 6, 1> J;
-        J << Y.cross(dI), dI;
-        residuals.push_back(s.intensity - own[j]);
+        point_jacobian[j] << Y.cross(dI), dI;
+        point_residual[j] = s.intensity - own[j];
+      }
+      residuals.clear();
+      jacobians.clear();
+      sampled_own.clear();
+      for (std::size_t j = 0; j < n; ++j) {
+        if (std::isnan(point_residual[j])) continue;
+        residuals.push_back(point_residual[j]);
         sampled_own.push_back(own[j]);
-        jacobians.push_back(J);
+        jacobians.push_back(point_jacobian[j]);
       }
       report.points = residuals.size();
       if (residuals.size() < std::max<std::size_t>(minimum, 6)) {
@@ -100,10 +125,10 @@ PhotometricRotationResult refineRotationPhotometrically(
       for (std::size_t k = 0; k < residuals.size(); ++k) {
         const double r = residuals[k];
         const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
-        H.selfadjointView<Eigen::Lower>().rankUpdate(jacobians[k], w);
+        // Fixed-size outer product: unrolled, far cheaper than a triangular rank update.
+        H.noalias() += (w * jacobians[k]) * jacobians[k].transpose();
         g += w * r * jacobians[k];
       }
-      H = H.selfadjointView<Eigen::Lower>();
       const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
       const Eigen::Matrix<double, 6, 1> xi = -ldlt.solve(g);
       ++report.iterations;

@@ -138,6 +138,22 @@ TEST(PhotometricRotation, CorrectsAWrongRotationTowardsTheGroundTruth) {
   }
 }
 
+TEST(PhotometricRotation, GivesTheSameRotationOnAnyThreadCount) {
+  // Points are handled in parallel but gathered in point order: bit-identical results.
+  const TumPair pair = loadPair(17);
+  const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 0.5);
+  cvo::CvoParams params = presetParams();
+  Eigen::Matrix4d first;
+  for (const int threads : {1, 2, 3}) {
+    params.num_threads = threads;
+    const cvo::PhotometricRotationResult out = cvo::refineRotationPhotometrically(
+        *pair.reference.image(), *pair.current.image(), pair.current, guess, params);
+    ASSERT_TRUE(out.report.applied) << out.report.skipped;
+    if (threads == 1) first = out.transform.matrix();
+    EXPECT_EQ(out.transform.matrix(), first) << threads << " threads";
+  }
+}
+
 TEST(PhotometricRotation, KeepsTheGuessWhenItCannotOrMustNotCorrect) {
   const TumPair pair = loadPair(10);
   const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 1.0);
