@@ -79,4 +79,9 @@ void loadFrontendParams(const std::string& path, CloudBuilderOptions* options) {
   parseFrontendParams(in, path, options);
 }
 
+CloudBuilderOptions frontendOptionsFor(CloudBuilderOptions options, const CvoParams& params) {
+  if (!params.photometric_rotation) options.image_levels = 0;
+  return options;
+}
+
 }  // namespace cvo

@@ -175,12 +175,13 @@ void CvoOdometryRos::loadParameters() {
 }
 
 void CvoOdometryRos::makeCloudBuilders() {
+  const CloudBuilderOptions cloud = frontendOptionsFor(cloud_options_, params_);
   RgbdFrontendOptions rgbd;
   rgbd.depth_units_per_metre = depth_units_per_metre_;
-  rgbd.cloud = cloud_options_;
+  rgbd.cloud = cloud;
   rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(rgbd);
   StereoFrontendOptions stereo;
-  stereo.cloud = cloud_options_;
+  stereo.cloud = cloud;
   stereo_builder_ = std::make_unique<StereoCloudBuilder>(stereo);
 }
 
@@ -581,17 +582,18 @@ void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
 }
 
 void CvoOdometryRos::applyPendingConfig() {
+  bool new_builders = false;
   if (pending_cloud_options_) {
     const auto& next = *pending_cloud_options_;
-    if (next.selector.min_points != cloud_options_.selector.min_points ||
-        next.selector.max_points != cloud_options_.selector.max_points) {
-      cloud_options_ = next;
-      makeCloudBuilders();
-    }
+    new_builders = next.selector.min_points != cloud_options_.selector.min_points ||
+                   next.selector.max_points != cloud_options_.selector.max_points;
+    cloud_options_ = next;
     pending_cloud_options_.reset();
   }
   if (pending_params_) {
     const bool new_backend = pending_params_->backend != params_.backend;
+    // The front end attaches the grey image levels only while the photometric stage is on.
+    new_builders |= pending_params_->photometric_rotation != params_.photometric_rotation;
     params_ = *pending_params_;
     pending_params_.reset();
     if (new_backend) {
@@ -603,6 +605,7 @@ void CvoOdometryRos::applyPendingConfig() {
     }
     ROS_INFO_STREAM("cvo_odometry: parameters updated:\n" << describe(params_, cloud_options_));
   }
+  if (new_builders) makeCloudBuilders();
 }
 
 void CvoOdometryRos::makeOdometry() {

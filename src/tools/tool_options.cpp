@@ -72,6 +72,7 @@ void readCloudOptions(const CommandLine& cli, CloudBuilderOptions* cloud) {
   if (cloud->semantic_classes > 0 && !cli.has("segmentation")) {
     throw std::invalid_argument("--semantic-classes needs --segmentation DIR");
   }
+  *cloud = frontendOptionsFor(*cloud, cvoParamsFrom(cli));
   cloud->validate();
 }
 

@@ -28,6 +28,18 @@ TEST(FrontendParams, ShippedPresetsLoadInBothLayers) {
   EXPECT_THROW(cvo::parseCvoParams(typo, "typo.yaml"), cvo::FormatError) << "unknown key";
 }
 
+TEST(FrontendParams, ImageLevelsOnlyWhenThePhotometricStageUsesThem) {
+  cvo::CloudBuilderOptions tum;
+  cvo::loadFrontendParams(kConfig + "/tum_rgbd.yaml", &tum);
+  cvo::CvoParams params = cvo::loadCvoParams(kConfig + "/tum_rgbd.yaml");
+  ASSERT_TRUE(params.photometric_rotation);
+  EXPECT_EQ(cvo::frontendOptionsFor(tum, params).image_levels, 2);
+  params.photometric_rotation = false;
+  const cvo::CloudBuilderOptions off = cvo::frontendOptionsFor(tum, params);
+  EXPECT_EQ(off.image_levels, 0);
+  EXPECT_EQ(off.selector.max_points, tum.selector.max_points) << "nothing else changes";
+}
+
 TEST(FrontendParams, BadValuesNameFileAndLine) {
   const std::string path = testing::TempDir() + "/bad_frontend.yaml";
   std::ofstream(path) << "ell_min: 0.05\nmin_points: many\n";

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cvo_odometry/core/cvo_params.hpp"
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 namespace cvo {
@@ -22,5 +23,9 @@ void parseFrontendParams(std::istream& in, const std::string& source_name,
 // Applies the front-end keys of a preset file (CVO keys skipped) and validates; FormatError
 // names the file and line of a bad value.
 void loadFrontendParams(const std::string& path, CloudBuilderOptions* options);
+
+// The options a front end should run with for these CVO parameters: the grey image levels only
+// when the photometric stage, their one user, is on (they cost a few ms a frame).
+CloudBuilderOptions frontendOptionsFor(CloudBuilderOptions options, const CvoParams& params);
 
 }  // namespace cvo
