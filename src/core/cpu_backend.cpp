@@ -67,18 +67,22 @@ void CpuBackend::Block::clear() {
 }
 
 void CpuBackend::Block::resize(std::size_t n) {
-  for (auto* v : {&x, &y, &z, &appearance, &appearance_d2})
+  for (auto* v : {&x, &y, &z})
     v->resize(n);
-  target.resize(n);
+  if (!appearance.empty()) {
+    appearance.resize(n);
+    appearance_d2.resize(n);
+  }
 }
 
 void CpuBackend::Block::move(std::size_t from, std::size_t to) {
-  target[to] = target[from];
   x[to] = x[from];
   y[to] = y[from];
   z[to] = z[from];
-  appearance[to] = appearance[from];
-  appearance_d2[to] = appearance_d2[from];
+  if (!appearance.empty()) {
+    appearance[to] = appearance[from];
+    appearance_d2[to] = appearance_d2[from];
+  }
 }
 
 void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& source,
@@ -136,8 +140,10 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   toRowMajor3x4(T, pose);
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
   const float reach2 = static_cast<float>(reach * reach);
+  const float radius2 = radius * radius;
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
+  const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
   const long block_count = static_cast<long>(blocks_.size());
   double radius_max = 0.0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount()) reduction(max : radius_max)
@@ -153,19 +159,23 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
       radius_max = std::max(
           radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
       if (constant_appearance_) {
-        // Geometry only: the grid's radius test is the joint-distance test.
-        grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
-          block.push(i, tgt + 3 * i, constants_.max_weight, 0.0f);
+        // Geometry only: the radius test is the joint-distance test.
+        grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+          for (std::uint32_t k = first; k < last; ++k) {
+            const float dx = xs[k] - z[0], dy = ys[k] - z[1], dz = zs[k] - z[2];
+            if (dx * dx + dy * dy + dz * dz <= radius2) block.push(xs[k], ys[k], zs[k]);
+          }
         });
       } else {
         grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
           const float appearance_d2 = appearanceDistance2(i, j);
           if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
-          block.push(i, tgt + 3 * i, kernels::appearanceWeight(constants_, appearance_d2),
+          const float* x = tgt + 3 * i;
+          block.push(x[0], x[1], x[2], kernels::appearanceWeight(constants_, appearance_d2),
                      appearance_d2);
         });
       }
-      block.offsets.push_back(static_cast<std::uint32_t>(block.target.size()));
+      block.offsets.push_back(static_cast<std::uint32_t>(block.size()));
     }
   }
   candidates_valid_ = true;
@@ -199,7 +209,7 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
       for (std::uint32_t c = first; c < last; ++c) {
         const float x[3] = {block.x[c], block.y[c], block.z[c]};
         const float d2 = kernels::squaredDistance(x, z, 3) * inv_ell2;
-        if (d2 + block.appearance_d2[c] >= reach2) continue;
+        if (d2 + (constant_appearance_ ? 0.0f : block.appearance_d2[c]) >= reach2) continue;
         block.move(c, kept++);
       }
       first = last;
@@ -270,10 +280,9 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
       const float* xs = block.x.data() + first;
       const float* ys = block.y.data() + first;
       const float* zs = block.z.data() + first;
-      const float* appearance = block.appearance.data() + first;
-      const kernels::PointSums sums =
-          sumCandidates(xs, ys, zs, constant ? nullptr : appearance, constant_appearance, count, z,
-                        inv_two_ell2, sp_thres);
+      const float* appearance = constant ? nullptr : block.appearance.data() + first;
+      const kernels::PointSums sums = sumCandidates(xs, ys, zs, appearance, constant_appearance,
+                                                    count, z, inv_two_ell2, sp_thres);
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
   });
@@ -365,7 +374,8 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
       kernels::makeTaylorFrame(z, xi.data(), frame);
       for (std::uint32_t c = block.offsets[k]; c < block.offsets[k + 1]; ++c) {
         const float x[3] = {block.x[c], block.y[c], block.z[c]};
-        const float a = kernels::retainedPairWeight(block.appearance[c], x[0] - z[0], x[1] - z[1],
+        const float appearance = constant_appearance_ ? constants_.max_weight : block.appearance[c];
+        const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1],
                                                     x[2] - z[2], inv_two_ell2, constants_.sp_thres);
         if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, inv_ell2);
       }

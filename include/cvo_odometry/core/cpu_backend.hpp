@@ -26,20 +26,23 @@ class CpuBackend : public RegistrationBackend {
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
 
  private:
-  // Candidate pairs of one block of source points, CSR layout.
+  // Candidate pairs of one block of source points, CSR layout. With geometry only every pair's
+  // appearance is the same constant: the appearance arrays stay empty.
   struct Block {
     std::vector<std::uint32_t> offsets;  // size = points in block + 1
-    std::vector<std::uint32_t> target;
-    std::vector<float> x, y, z;        // the target point, copied: unit-stride loads vectorise
-    std::vector<float> appearance;     // s^2 times the appearance factors of the pair
-    std::vector<float> appearance_d2;  // scaled appearance distance (pose independent)
+    std::vector<float> x, y, z;          // the target point, copied: unit-stride loads vectorise
+    std::vector<float> appearance;       // s^2 times the appearance factors of the pair
+    std::vector<float> appearance_d2;    // scaled appearance distance (pose independent)
 
+    std::size_t size() const { return x.size(); }
     void clear();
-    void push(std::uint32_t index, const float* position, float weight, float distance2) {
-      target.push_back(index);
-      x.push_back(position[0]);
-      y.push_back(position[1]);
-      z.push_back(position[2]);
+    void push(float px, float py, float pz) {
+      x.push_back(px);
+      y.push_back(py);
+      z.push_back(pz);
+    }
+    void push(float px, float py, float pz, float weight, float distance2) {
+      push(px, py, pz);
       appearance.push_back(weight);
       appearance_d2.push_back(distance2);
     }
