@@ -20,7 +20,9 @@ bool cudaBackendAvailable(std::string* why_not) {
 #endif
 }
 
-std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads) {
+std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads,
+                                                 std::string* why_cpu) {
+  if (why_cpu) why_cpu->clear();
   if (choice != BackendChoice::kCpu) {
     std::string why_not;
     if (cudaBackendAvailable(&why_not)) {
@@ -37,6 +39,7 @@ std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_t
     if (choice == BackendChoice::kCuda) {
       throw std::runtime_error("CUDA backend requested but unavailable: " + why_not);
     }
+    if (why_cpu) *why_cpu = "backend auto: the CPU, " + why_not;
   }
   return std::make_unique<CpuBackend>(num_threads);
 }

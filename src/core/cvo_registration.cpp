@@ -17,7 +17,7 @@ CvoRegistration::CvoRegistration(const CvoParams& params,
                                  std::unique_ptr<RegistrationBackend> backend)
     : params_(params), backend_(std::move(backend)) {
   params_.validate();
-  if (!backend_) backend_ = makeBackend(params_.backend, params_.num_threads);
+  if (!backend_) backend_ = makeBackend(params_.backend, params_.num_threads, &backend_note_);
 }
 
 CvoRegistration::~CvoRegistration() = default;

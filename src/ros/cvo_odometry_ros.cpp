@@ -609,7 +609,10 @@ void CvoOdometryRos::applyPendingConfig() {
 }
 
 void CvoOdometryRos::makeOdometry() {
-  std::unique_ptr<RegistrationBackend> backend = makeBackend(params_.backend, params_.num_threads);
+  std::string why_cpu;
+  std::unique_ptr<RegistrationBackend> backend =
+      makeBackend(params_.backend, params_.num_threads, &why_cpu);
+  if (!why_cpu.empty()) ROS_INFO_STREAM("cvo_odometry: " << why_cpu);
   if (inject_backend_fault_after_ >= 0) {
     // Test hook: the backend fails from then on, as a GPU lost mid-run; the CPU takes over.
     ROS_WARN_STREAM("cvo_odometry: the backend will fail after " << inject_backend_fault_after_

@@ -61,6 +61,9 @@ int main(int argc, char** argv) {
               << " frames, backend " << odometry.registration().backend().name() << ", step "
               << cvo::toString(params.step_method) << ", colour "
               << (params.use_color ? "on" : "off") << "\n";
+    if (!odometry.registration().backendNote().empty()) {
+      std::cerr << "cvo_run_sequence: " << odometry.registration().backendNote() << "\n";
+    }
 
     cvo::Trajectory trajectory;
     cvo::StageTimer timer;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "cvo_odometry/core/backend_factory.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/cvo_steps.hpp"
@@ -309,4 +310,21 @@ TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
   // The replayed lists may hold other not-retained candidates, which changes the float lane
   // order of the sums: the same answer to rounding, not to the bit.
   EXPECT_LT((got.transform.matrix() - expected.transform.matrix()).norm(), 1e-6);
+}
+
+TEST(CvoRegistration, AutoBackendSaysWhyItRunsOnTheCpu) {
+  std::string why_cpu, unavailable;
+  const auto chosen = cvo::makeBackend(cvo::BackendChoice::kAuto, 1, &why_cpu);
+  if (cvo::cudaBackendAvailable(&unavailable)) {
+    EXPECT_EQ(chosen->name(), "cuda");
+    EXPECT_TRUE(why_cpu.empty()) << why_cpu;
+  } else {
+    EXPECT_EQ(chosen->name(), "cpu");
+    EXPECT_NE(why_cpu.find(unavailable), std::string::npos) << why_cpu;
+    CvoParams params = syntheticParams(false);
+    params.backend = cvo::BackendChoice::kAuto;
+    EXPECT_EQ(CvoRegistration(params).backendNote(), why_cpu);
+  }
+  cvo::makeBackend(cvo::BackendChoice::kCpu, 1, &why_cpu);
+  EXPECT_TRUE(why_cpu.empty()) << "a CPU asked for needs no reason";
 }

@@ -11,6 +11,8 @@ namespace cvo {
 bool cudaBackendAvailable(std::string* why_not = nullptr);
 
 // auto: CUDA when available, else the CPU; cuda: throws std::runtime_error when unavailable.
-std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads = 0);
+// `why_cpu`, when given, receives why auto chose the CPU (empty otherwise), for the log.
+std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads = 0,
+                                                 std::string* why_cpu = nullptr);
 
 }  // namespace cvo

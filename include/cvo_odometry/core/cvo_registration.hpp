@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -47,6 +48,8 @@ class CvoRegistration {
   const CvoParams& params() const { return params_; }
   void setParams(const CvoParams& params);
   RegistrationBackend& backend() { return *backend_; }
+  // Why `backend: auto` settled on the CPU (no device, a build without CUDA), else empty.
+  const std::string& backendNote() const { return backend_note_; }
 
  private:
   void checkInputs(const LabeledCloud& target, const LabeledCloud& source) const;
@@ -63,6 +66,7 @@ class CvoRegistration {
 
   CvoParams params_;
   std::unique_ptr<RegistrationBackend> backend_;
+  std::string backend_note_;
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   LabeledCloud strided_target_;
