@@ -19,7 +19,9 @@ struct StereoMatcherOptions {
   int uniqueness_ratio = 10;
   int speckle_window_size = 100;
   int speckle_range = 2;
-  std::string mode = "sgbm";  // sgbm | hh | sgbm_3way
+  // sgbm | hh | sgbm_3way. sgbm_3way: OpenCV's multi-threaded variant; on KITTI 06 here it is
+  // 2.6x faster than sgbm with lower odometry error (README, the KITTI accuracy table).
+  std::string mode = "sgbm_3way";
 
   void validate() const;
 };
