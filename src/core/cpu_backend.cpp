@@ -288,67 +288,63 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
   });
 }
 
-kernels::MomentSums CpuBackend::gridMoments(const Eigen::Isometry3d& T, double ell) {
-  // Only pairs within the cut-off can be retained: the grid at that radius, no skin; pairs
-  // beyond it in the ranges weigh 0 in the pair loop.
+template <class PointSumsAt>
+kernels::MomentSums CpuBackend::sumFromGrid(const Eigen::Isometry3d& T, double ell,
+                                            PointSumsAt&& point_sums) {
+  // Only pairs within the cut-off can be retained: the grid at that radius, no skin.
   const float radius = static_cast<float>(std::sqrt(cutoff2_) * ell);
   ensureGrid(radius);
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const float* src = source_->positionData().data();
-  const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
   return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
-    // A point's ranges copied into one run: one vectorised loop a point, not one a range.
-    std::vector<float> run_x, run_y, run_z;
     const std::size_t begin = b * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
     for (std::size_t j = begin; j < end; ++j) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * j, z);
-      run_x.clear();
-      run_y.clear();
-      run_z.clear();
-      grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
-        run_x.insert(run_x.end(), xs + first, xs + last);
-        run_y.insert(run_y.end(), ys + first, ys + last);
-        run_z.insert(run_z.end(), zs + first, zs + last);
-      });
-      const kernels::PointSums sums =
-          sumCandidates(run_x.data(), run_y.data(), run_z.data(), nullptr, constants_.max_weight,
-                        static_cast<int>(run_x.size()), z, inv_two_ell2, constants_.sp_thres);
+      const kernels::PointSums sums = point_sums(j, z, radius, inv_two_ell2);
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
+  });
+}
+
+kernels::MomentSums CpuBackend::gridMoments(const Eigen::Isometry3d& T, double ell) {
+  return sumFromGrid(T, ell, [&](std::size_t, const float* z, float radius, float inv_two_ell2) {
+    // The grid is (re)built by sumFromGrid: its arrays are read here, after that.
+    const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
+    // A point's ranges copied into one run: one vectorised loop a point, not one a range
+    // (pairs beyond the cut-off in the ranges weigh 0 in the loop).
+    thread_local std::vector<float> run_x, run_y, run_z;
+    run_x.clear();
+    run_y.clear();
+    run_z.clear();
+    grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+      run_x.insert(run_x.end(), xs + first, xs + last);
+      run_y.insert(run_y.end(), ys + first, ys + last);
+      run_z.insert(run_z.end(), zs + first, zs + last);
+    });
+    return sumCandidates(run_x.data(), run_y.data(), run_z.data(), nullptr, constants_.max_weight,
+                         static_cast<int>(run_x.size()), z, inv_two_ell2, constants_.sp_thres);
   });
 }
 
 kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
   if (candidatesHold(T, ell)) return moments(T, ell);
   if (constant_appearance_) return gridMoments(T, ell);
-  const float radius = static_cast<float>(std::sqrt(cutoff2_) * ell);
-  ensureGrid(radius);
-  float pose[12];
-  toRowMajor3x4(T, pose);
-  const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const float* tgt = target_->positionData().data();
-  const float* src = source_->positionData().data();
-  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
-    const std::size_t begin = b * kBlockSize;
-    const std::size_t end = std::min(begin + kBlockSize, source_->size());
-    for (std::size_t j = begin; j < end; ++j) {
-      float z[3];
-      kernels::transformPoint(pose, src + 3 * j, z);
-      kernels::PointSums sums;
-      kernels::clear(sums);
-      grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
-        const float* x = tgt + 3 * i;
-        const float appearance = kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
-        const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1],
-                                                    x[2] - z[2], inv_two_ell2, constants_.sp_thres);
-        kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
-      });
-      if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
-    }
+  return sumFromGrid(T, ell, [&](std::size_t j, const float* z, float radius, float inv_two_ell2) {
+    kernels::PointSums sums;
+    kernels::clear(sums);
+    grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
+      const float* x = tgt + 3 * i;
+      const float appearance = kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
+      const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1], x[2] - z[2],
+                                                  inv_two_ell2, constants_.sp_thres);
+      kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
+    });
+    return sums;
   });
 }
 

@@ -62,7 +62,11 @@ class CpuBackend : public RegistrationBackend {
   double movedSinceBuild(const Eigen::Isometry3d& T) const;
   // The target's grid with this cell size (kept while the problem and size stay).
   void ensureGrid(float radius);
-  // Geometry only: the moments read straight from the grid's sorted ranges (no lists).
+  // Moments straight from the grid at the cut-off radius (no lists): point_sums(j, T z_j,
+  // radius, 1 / (2 ell^2)) gives each source point's sums.
+  template <class PointSumsAt>
+  kernels::MomentSums sumFromGrid(const Eigen::Isometry3d& T, double ell, PointSumsAt&& point_sums);
+  // Geometry only: the moments read from the grid's sorted ranges by the vectorised loop.
   kernels::MomentSums gridMoments(const Eigen::Isometry3d& T, double ell);
   // Scaled appearance distance of target point i and source point j (colour, semantics).
   float appearanceDistance2(std::uint32_t i, std::size_t j) const;
