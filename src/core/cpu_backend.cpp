@@ -60,6 +60,47 @@ CVO_CPU_DISPATCH kernels::PointSums sumCandidates(const float* xs, const float* 
   return kernels::PointSums{weight, {ox, oy, oz}, static_cast<unsigned int>(pairs)};
 }
 
+// The curvature sums of one source point over its candidates (as sumCandidates).
+CVO_CPU_DISPATCH kernels::PointCurvature curvatureOfCandidates(
+    const float* xs, const float* ys, const float* zs, const float* appearance, float constant,
+    int count, const float* z, float inv_two_ell2, float sp_thres, float inv_shell_width) {
+  const float zx = z[0], zy = z[1], zz = z[2];
+  const float shell_top = sp_thres + 1.0f / inv_shell_width;
+  float w = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
+  float sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+  float bxx = 0.0f, bxy = 0.0f, bxz = 0.0f, byy = 0.0f, byz = 0.0f, bzz = 0.0f, pairs = 0.0f;
+#pragma omp simd reduction(+ : w, ox, oy, oz, sxx, sxy, sxz, syy, syz, szz, bxx, bxy, bxz, byy, \
+                               byz, bzz, pairs)
+  for (int c = 0; c < count; ++c) {
+    const float dx = xs[c] - zx, dy = ys[c] - zy, dz = zs[c] - zz;
+    const float a = kernels::retainedPairWeight(appearance ? appearance[c] : constant, dx, dy, dz,
+                                                inv_two_ell2, sp_thres);
+    const float shell = a > 0.0f && a < shell_top ? a * a * inv_shell_width : 0.0f;
+    w += a;
+    pairs += a > 0.0f ? 1.0f : 0.0f;
+    ox += a * dx;
+    oy += a * dy;
+    oz += a * dz;
+    sxx += a * dx * dx;
+    sxy += a * dx * dy;
+    sxz += a * dx * dz;
+    syy += a * dy * dy;
+    syz += a * dy * dz;
+    szz += a * dz * dz;
+    bxx += shell * dx * dx;
+    bxy += shell * dx * dy;
+    bxz += shell * dx * dz;
+    byy += shell * dy * dy;
+    byz += shell * dy * dz;
+    bzz += shell * dz * dz;
+  }
+  return kernels::PointCurvature{w,
+                                 {ox, oy, oz},
+                                 {sxx, sxy, sxz, syy, syz, szz},
+                                 {bxx, bxy, bxz, byy, byz, bzz},
+                                 static_cast<unsigned int>(pairs)};
+}
+
 }  // namespace
 
 void CpuBackend::Block::clear() {
@@ -346,6 +387,48 @@ kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double
     });
     return sums;
   });
+}
+
+kernels::CurvatureSums CpuBackend::curvature(const Eigen::Isometry3d& T, double ell) {
+  ensureCandidates(T, ell);
+  float pose[12];
+  toRowMajor3x4(T, pose);
+  const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+  const double inv_ell2 = 1.0 / (ell * ell);
+  const float inv_shell_width = kernels::inverseShellWidth(constants_.sp_thres);
+  const float* src = source_->positionData().data();
+  const bool constant = constant_appearance_;
+  const long block_count = static_cast<long>(blocks_.size());
+  std::vector<kernels::CurvatureSums> partial(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
+  for (long b = 0; b < block_count; ++b) {
+    const Block& block = blocks_[b];
+    kernels::clear(partial[b]);
+    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    for (std::size_t k = 0; k + 1 < block.offsets.size(); ++k) {
+      float z[3];
+      kernels::transformPoint(pose, src + 3 * (begin + k), z);
+      const std::uint32_t first = block.offsets[k];
+      const int count = static_cast<int>(block.offsets[k + 1] - first);
+      const float* appearance = constant ? nullptr : block.appearance.data() + first;
+      if ((begin + k) % kernels::kCurvatureStride == 0) {
+        const kernels::PointCurvature sums = curvatureOfCandidates(
+            block.x.data() + first, block.y.data() + first, block.z.data() + first, appearance,
+            constants_.max_weight, count, z, inv_two_ell2, constants_.sp_thres, inv_shell_width);
+        kernels::accumulatePointCurvature(partial[b], sums, z, inv_ell2, kernels::kCurvatureStride);
+      } else {
+        const kernels::PointSums sums = sumCandidates(
+            block.x.data() + first, block.y.data() + first, block.z.data() + first, appearance,
+            constants_.max_weight, count, z, inv_two_ell2, constants_.sp_thres);
+        if (sums.pairs > 0) kernels::accumulatePoint(partial[b].moments, sums, z);
+      }
+    }
+  }
+  kernels::CurvatureSums total;
+  kernels::clear(total);
+  for (const auto& c : partial)
+    kernels::add(total, c);
+  return total;
 }
 
 kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) {

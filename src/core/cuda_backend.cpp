@@ -29,4 +29,10 @@ kernels::TaylorSums CudaBackend::taylor(const Eigen::Isometry3d& T, const Vector
   return device_.taylor(pose, xi.data(), ell);
 }
 
+kernels::CurvatureSums CudaBackend::curvature(const Eigen::Isometry3d& T, double ell) {
+  float pose[12];
+  toRowMajor3x4(T, pose);
+  return device_.curvature(pose, ell);
+}
+
 }  // namespace cvo

@@ -102,10 +102,15 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
   double omega = 1.0;
   double previous_weight = -1.0;
   int level_iterations = 0;
+  bool newton_allowed = params_.newton_at_ell_min, last_was_newton = false;
   report.message = "iteration limit reached";
   for (int it = 0; it < params_.max_iterations; ++it) {
     useCloudsForLengthscale(ell);
-    const kernels::MomentSums m = backend_->moments(T, ell);
+    // At ell_min, while Newton steps are on, one pass gives the moments and the curvature.
+    const bool with_curvature = newton_allowed && ell <= params_.ell_min;
+    kernels::CurvatureSums curvature;
+    if (with_curvature) curvature = backend_->curvature(T, ell);
+    const kernels::MomentSums m = with_curvature ? curvature.moments : backend_->moments(T, ell);
     report.iterations = it + 1;
     pair_total += static_cast<double>(m.pairs);
     if (m.pairs < 3) {
@@ -116,13 +121,34 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     // The MM fixed point is a stationary point of the continuous sum_ij (a_ij - sp_thres)_+
     // (the retained-pair sum F jumps as pairs cross the threshold): steer by that.
     const double smooth_weight = m.weight - params_.sp_thres * static_cast<double>(m.pairs);
+    const bool fell = previous_weight >= 0.0 && smooth_weight < previous_weight;
+    // A Newton step after which F fell: its quadratic model misleads here, MM steps from now on.
+    if (fell && last_was_newton) newton_allowed = false;
+    last_was_newton = false;
     if (previous_weight >= 0.0) {
       omega = smooth_weight >= previous_weight ? std::min(omega * 1.5, params_.max_overrelaxation)
                                                : 1.0;
     }
     previous_weight = smooth_weight;
     const Vector6d step = lie::logSE3(weightedProcrustes(m));
-    T = lie::orthonormalized(lie::expSE3(omega * step) * T);
+    Vector6d newton;
+    // Near the optimum MM steps converge linearly, slowly along weakly constrained directions;
+    // Newton's converge quadratically. Taken only while F rises, where the Hessian is negative
+    // definite and the step stays within 10x the MM step (a guard against a misleading model).
+    bool took_newton = false;
+    if (with_curvature && !fell) {
+      took_newton =
+          newtonStep(curvature, ell, &newton) && newton.norm() < 10.0 * step.norm() + 1e-4;
+      // A model without a maximum nearby will not have one an iteration later either: stop
+      // paying for the curvature sums.
+      newton_allowed = took_newton;
+    }
+    if (took_newton) {
+      T = lie::orthonormalized(lie::expSE3(newton) * T);
+      last_was_newton = true;
+    } else {
+      T = lie::orthonormalized(lie::expSE3(omega * step) * T);
+    }
     report.last_step = step.norm();  // the plain MM step decides convergence
     ++level_iterations;
     if (ell > params_.ell_min) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 
 namespace cvo {
@@ -32,6 +33,21 @@ Eigen::Isometry3d weightedProcrustes(const kernels::MomentSums& m) {
   D.linear() = svd.matrixV() * S * svd.matrixU().transpose();
   D.translation() = x_mean - D.linear() * z_mean;
   return D;
+}
+
+bool newtonStep(const kernels::CurvatureSums& c, double ell, Vector6d* step) {
+  Eigen::Matrix<double, 6, 6> H;
+  int slot = 0;
+  for (int r = 0; r < 6; ++r) {
+    for (int k = r; k < 6; ++k)
+      H(r, k) = H(k, r) = c.hessian[slot++];
+  }
+  const Vector6d g = objectiveGradient(c.moments, ell);
+  // H negative definite <=> -H has a Cholesky factorisation.
+  const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(-H);
+  if (llt.info() != Eigen::Success) return false;
+  *step = llt.solve(g);
+  return step->allFinite();
 }
 
 double smallestPositiveCubicRoot(double a, double b, double c, double d) {

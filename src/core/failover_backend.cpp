@@ -63,4 +63,8 @@ kernels::TaylorSums FailoverBackend::taylor(const Eigen::Isometry3d& T, const Ve
   return run([&](RegistrationBackend& b) { return b.taylor(T, xi, ell); });
 }
 
+kernels::CurvatureSums FailoverBackend::curvature(const Eigen::Isometry3d& T, double ell) {
+  return run([&](RegistrationBackend& b) { return b.curvature(T, ell); });
+}
+
 }  // namespace cvo

@@ -40,4 +40,9 @@ kernels::TaylorSums FaultInjectionBackend::taylor(const Eigen::Isometry3d& T, co
   return inner_->taylor(T, xi, ell);
 }
 
+kernels::CurvatureSums FaultInjectionBackend::curvature(const Eigen::Isometry3d& T, double ell) {
+  countCall();
+  return inner_->curvature(T, ell);
+}
+
 }  // namespace cvo

@@ -44,6 +44,7 @@ void visitScalars(Params& p, Visitor&& f) {
   f("subsample_coarse_levels", p.subsample_coarse_levels);
   f("max_overrelaxation", p.max_overrelaxation);
   f("max_level_iterations", p.max_level_iterations);
+  f("newton_at_ell_min", p.newton_at_ell_min);
   f("photometric_rotation", p.photometric_rotation);
   f("photometric_iterations", p.photometric_iterations);
   f("photometric_max_correction", p.photometric_max_correction);

@@ -11,6 +11,8 @@
 
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/cvo_steps.hpp"
 #include "cvo_odometry/core/dense_grid.hpp"
 #include "cvo_odometry/core/voxel_grid.hpp"
 
@@ -140,6 +142,60 @@ TEST(CpuBackendGridSums, MatchTheCandidateLists) {
       EXPECT_EQ(c.weight, a.weight) << what;
     }
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The Newton step's Hessian (analytic, from every kCurvatureStride-th point, with the threshold's
+// shell term) against central differences of the exact gradient, on real TUM clouds near
+// alignment; and the moments that come with it equal the plain evaluation's.
+TEST(CpuBackendCurvature, HessianMatchesDifferencesOfTheGradient) {
+  const cvo::LabeledCloud target =
+      cvo::readCloud(std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_8000.cloud");
+  const cvo::LabeledCloud source =
+      cvo::readCloud(std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame11_8000.cloud");
+  cvo::CvoParams params;
+  params.use_color = false;
+  params.ell_min = 0.02;
+  params.sp_thres = 0.003;
+  const double ell = 0.02;
+  cvo::CpuBackend backend(2);
+  backend.setProblem(target, source, params);
+  // Near the optimum (a registration's result, moved by 1 mm), where Newton steps are taken.
+  params.newton_at_ell_min = false;
+  cvo::CvoRegistration registration(params, std::make_unique<cvo::CpuBackend>(2));
+  Eigen::Isometry3d T =
+      registration.align(target, source, Eigen::Isometry3d::Identity(), false).transform;
+  T.translation() += Eigen::Vector3d(0.001, -0.0005, 0.0005);
+  backend.setProblem(target, source, params);
+  const cvo::kernels::CurvatureSums c = backend.curvature(T, ell);
+  const cvo::kernels::MomentSums m = backend.moments(T, ell);
+  EXPECT_EQ(c.moments.pairs, m.pairs);
+  EXPECT_NEAR(c.moments.weight, m.weight, 1e-6 * m.weight);
+  Eigen::Matrix<double, 6, 6> analytic, differences;
+  int slot = 0;
+  for (int r = 0; r < 6; ++r) {
+    for (int k = r; k < 6; ++k)
+      analytic(r, k) = analytic(k, r) = c.hessian[slot++];
+  }
+  const double h = 2e-4;
+  for (int k = 0; k < 6; ++k) {
+    cvo::Vector6d e = cvo::Vector6d::Zero();
+    e[k] = h;
+    differences.col(k) =
+        (cvo::objectiveGradient(backend.moments(cvo::lie::expSE3(e) * T, ell), ell) -
+         cvo::objectiveGradient(backend.moments(cvo::lie::expSE3(-e) * T, ell), ell)) /
+        (2.0 * h);
+  }
+  const Eigen::Matrix<double, 6, 6> symmetric = 0.5 * (differences + differences.transpose());
+  const double error = (analytic - symmetric).norm() / symmetric.norm();
+  EXPECT_LT(error, 0.15) << "analytic\n" << analytic << "\ndifferences\n" << symmetric;
+  cvo::Vector6d step;
+  ASSERT_TRUE(cvo::newtonStep(c, ell, &step)) << "negative definite near the optimum";
+  const cvo::Vector6d reference = -symmetric.ldlt().solve(cvo::objectiveGradient(m, ell));
+  EXPECT_GT(step.dot(reference) / (step.norm() * reference.norm()), 0.9);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@ class CpuBackend : public RegistrationBackend {
   // From the candidate lists when they hold the pose, else straight from the grid (no lists).
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
+  kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
 
  private:
   // Candidate pairs of one block of source points, CSR layout. With geometry only every pair's

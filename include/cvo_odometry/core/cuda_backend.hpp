@@ -17,6 +17,7 @@ class CudaBackend : public RegistrationBackend {
                   const CvoParams& params) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
+  kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
 
  private:
   DevicePairSums device_;

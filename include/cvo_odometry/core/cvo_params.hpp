@@ -62,6 +62,10 @@ struct CvoParams {
   double max_overrelaxation = 2.0;
   // Iterations after which a coarse level ends even if its steps are not yet small.
   int max_level_iterations = 30;
+  // At ell_min, Newton steps (analytic gradient and Hessian of sum (a - sp_thres)_+) where the
+  // Hessian is negative definite and the step stays within 10x the MM step; after the first
+  // Newton step that F does not follow upwards, MM steps only.
+  bool newton_at_ell_min = true;
 
   // Photometric rotation stage after CVO (see photometric_rotation.hpp): needs clouds that carry
   // their image (the RGB-D front end attaches it). Gauss-Newton iterations per image level; a

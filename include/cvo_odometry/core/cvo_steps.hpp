@@ -16,6 +16,10 @@ Vector6d objectiveGradient(const kernels::MomentSums& m, double ell);
 // when fewer than three pairs carry weight.
 Eigen::Isometry3d weightedProcrustes(const kernels::MomentSums& m);
 
+// The Newton step -H^-1 g that maximises the quadratic model of F(exp(xi) T); false (no step)
+// when the Hessian is not negative definite (the model has no maximum) or the step is not finite.
+bool newtonStep(const kernels::CurvatureSums& c, double ell, Vector6d* step);
+
 // Smallest positive real root of a t^3 + b t^2 + c t + d, or a negative value if none.
 double smallestPositiveCubicRoot(double a, double b, double c, double d);
 

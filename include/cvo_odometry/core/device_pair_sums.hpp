@@ -28,6 +28,7 @@ class DevicePairSums {
   // Sums with the source moved by the row-major 3x4 `pose`, at lengthscale `ell`.
   kernels::MomentSums moments(const float* pose, double ell);
   kernels::TaylorSums taylor(const float* pose, const double* xi, double ell);
+  kernels::CurvatureSums curvature(const float* pose, double ell);
 
  private:
   struct Impl;

@@ -21,6 +21,7 @@ class FailoverBackend : public RegistrationBackend {
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
+  kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
 
   void restore() { failed_ = false; }
   bool failedOver() const { return failed_; }

@@ -20,6 +20,7 @@ class FaultInjectionBackend : public RegistrationBackend {
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
+  kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
 
  private:
   void countCall();

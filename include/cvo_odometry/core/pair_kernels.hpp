@@ -52,6 +52,27 @@ struct PointSums {
   unsigned int pairs;
 };
 
+// For the Newton step at the finest lengthscale: the moments over every source point and the
+// Hessian of G(exp(xi) T) = sum (a - sp_thres)_+ at xi = 0 (twist [omega; v]) estimated from every
+// kCurvatureStride-th source point (scaled up; a step metric needs no more), upper triangle row
+// by row (21 values). The gradient comes from the moments (objectiveGradient).
+constexpr int kCurvatureStride = 4;
+struct CurvatureSums {
+  MomentSums moments;
+  double hessian[21];
+};
+
+// Per-source-point sums for CurvatureSums, in float: sum a, sum a d, sum a d d^T (upper
+// triangle: xx, xy, xz, yy, yz, zz), d = x - z, and over the pairs just above the threshold
+// (the shell sp_thres < a < sp_thres + shell_width) sum a^2 d d^T / shell_width.
+struct PointCurvature {
+  float weight;
+  float offset[3];
+  float outer[6];
+  float shell[6];
+  unsigned int pairs;
+};
+
 CVO_HOST_DEVICE inline void clear(MomentSums& m) {
   m.weight = 0.0;
   for (int k = 0; k < 3; ++k)
@@ -94,6 +115,27 @@ CVO_HOST_DEVICE inline void add(PointSums& p, const PointSums& o) {
   for (int k = 0; k < 3; ++k)
     p.offset[k] += o.offset[k];
   p.pairs += o.pairs;
+}
+
+CVO_HOST_DEVICE inline void clear(CurvatureSums& c) {
+  clear(c.moments);
+  for (int k = 0; k < 21; ++k)
+    c.hessian[k] = 0.0;
+}
+
+CVO_HOST_DEVICE inline void add(CurvatureSums& c, const CurvatureSums& o) {
+  add(c.moments, o.moments);
+  for (int k = 0; k < 21; ++k)
+    c.hessian[k] += o.hessian[k];
+}
+
+CVO_HOST_DEVICE inline void clear(PointCurvature& p) {
+  p.weight = 0.0f;
+  for (int k = 0; k < 3; ++k)
+    p.offset[k] = 0.0f;
+  for (int k = 0; k < 6; ++k)
+    p.outer[k] = p.shell[k] = 0.0f;
+  p.pairs = 0;
 }
 
 CVO_HOST_DEVICE inline float floatFromBits(int bits) {
@@ -179,6 +221,79 @@ CVO_HOST_DEVICE inline void accumulatePoint(MomentSums& m, const PointSums& p, c
       m.cross[3 * r + c] += target * z[c];
   }
   m.pairs += p.pairs;
+}
+
+// 1 / width of the shell above sp_thres whose pairs stand for the threshold's kink: a quarter of
+// sp_thres (narrower is noisier, wider blurs the kink).
+CVO_HOST_DEVICE inline float inverseShellWidth(float sp_thres) {
+  return 4.0f / sp_thres;
+}
+
+// Adds a pair's weight (0 for a pair not retained) to its source point's curvature sums.
+CVO_HOST_DEVICE inline void accumulateCurvaturePair(PointCurvature& p, float a, float dx, float dy,
+                                                    float dz, float sp_thres,
+                                                    float inv_shell_width) {
+  const float o[6] = {dx * dx, dx * dy, dx * dz, dy * dy, dy * dz, dz * dz};
+  p.weight += a;
+  p.offset[0] += a * dx;
+  p.offset[1] += a * dy;
+  p.offset[2] += a * dz;
+  p.pairs += a > 0.0f ? 1u : 0u;
+  const float shell =
+      a > 0.0f && a < sp_thres + 1.0f / inv_shell_width ? a * a * inv_shell_width : 0.0f;
+  for (int k = 0; k < 6; ++k) {
+    p.outer[k] += a * o[k];
+    p.shell[k] += shell * o[k];
+  }
+}
+
+// Folds one source point (at y = T z) into the moments and, times `hessian_scale`, into the
+// Hessian of G(exp(xi) T). With J = [-[y]x | I] (d y / d xi), A = sum a, b = sum a d,
+// S = sum a d d^T over its pairs and B the shell sum (the pairs crossing the threshold, where
+// (a - sp_thres)_+ kinks):
+//   H = J^T (S + B) J / l^4 - A J^T J / l^2 + Q(b) / l^2,
+// Q from the second-order terms of exp (1/2 w x (w x y) + 1/2 w x v):
+//   Q_ww = (b y^T + y b^T) / 2 - (b . y) I, Q_wv = -[b]x / 2, Q_vv = 0.
+CVO_HOST_DEVICE inline void accumulatePointCurvature(CurvatureSums& c, const PointCurvature& p,
+                                                     const float* y_float, double inv_ell2,
+                                                     double hessian_scale) {
+  if (p.pairs == 0) return;
+  accumulatePoint(c.moments, PointSums{p.weight, {p.offset[0], p.offset[1], p.offset[2]}, p.pairs},
+                  y_float);
+  const double y[3] = {y_float[0], y_float[1], y_float[2]};
+  const double A = p.weight;
+  const double b[3] = {p.offset[0], p.offset[1], p.offset[2]};
+  double s6[6];
+  for (int k = 0; k < 6; ++k)
+    s6[k] = static_cast<double>(p.outer[k]) + static_cast<double>(p.shell[k]);
+  const double S[3][3] = {{s6[0], s6[1], s6[2]}, {s6[1], s6[3], s6[4]}, {s6[2], s6[4], s6[5]}};
+  // J (3 x 6): columns 0-2 are -[y]x, columns 3-5 the identity.
+  const double J[3][6] = {{0.0, y[2], -y[1], 1.0, 0.0, 0.0},
+                          {-y[2], 0.0, y[0], 0.0, 1.0, 0.0},
+                          {y[1], -y[0], 0.0, 0.0, 0.0, 1.0}};
+  double SJ[3][6];  // S J
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 6; ++k)
+      SJ[r][k] = S[r][0] * J[0][k] + S[r][1] * J[1][k] + S[r][2] * J[2][k];
+  }
+  // [b]x, for Q_wv = -[b]x / 2.
+  const double cross_b[3][3] = {{0.0, -b[2], b[1]}, {b[2], 0.0, -b[0]}, {-b[1], b[0], 0.0}};
+  const double by = b[0] * y[0] + b[1] * y[1] + b[2] * y[2];
+  const double inv_ell4 = inv_ell2 * inv_ell2;
+  int slot = 0;
+  for (int r = 0; r < 6; ++r) {
+    for (int k = r; k < 6; ++k) {
+      const double jsj = J[0][r] * SJ[0][k] + J[1][r] * SJ[1][k] + J[2][r] * SJ[2][k];
+      const double jj = J[0][r] * J[0][k] + J[1][r] * J[1][k] + J[2][r] * J[2][k];
+      double q = 0.0;
+      if (k < 3) {
+        q = 0.5 * (b[r] * y[k] + y[r] * b[k]) - (r == k ? by : 0.0);
+      } else if (r < 3) {
+        q = -0.5 * cross_b[r][k - 3];
+      }
+      c.hessian[slot++] += hessian_scale * (jsj * inv_ell4 - A * jj * inv_ell2 + q * inv_ell2);
+    }
+  }
 }
 
 // Moves a point by a row-major 3x4 float transform.

@@ -34,6 +34,9 @@ class RegistrationBackend {
   // Taylor coefficients of F(exp(t xi) T) in t, over the pairs retained at T.
   virtual kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi,
                                      double ell) = 0;
+  // Gradient and Hessian of sum (a - sp_thres)_+ at exp(xi) T, xi = 0, over the pairs retained
+  // at T (the Newton step at the finest lengthscale).
+  virtual kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) = 0;
 };
 
 // Squared cut-off of the scaled joint distance D^2 = |x - z|^2 / ell^2 + sum_V |u - v|^2 / ell_V^2:

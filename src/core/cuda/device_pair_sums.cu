@@ -146,6 +146,48 @@ __global__ void taylorKernel(CloudView target, CloudView source, GridView grid,
   if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
 }
 
+__global__ void curvatureKernel(CloudView target, CloudView source, GridView grid,
+                                kernels::KernelConstants k, Pose3x4 pose, float inv_two_ell2,
+                                double inv_ell2, kernels::CurvatureSums* partial) {
+  __shared__ kernels::CurvatureSums shared[kThreads];
+  const int j = blockIdx.x * blockDim.x + threadIdx.x;
+  kernels::CurvatureSums mine;
+  kernels::clear(mine);
+  if (j < source.count) {
+    float z[3];
+    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
+    if (j % kernels::kCurvatureStride == 0) {
+      kernels::PointCurvature sums;
+      kernels::clear(sums);
+      const float inv_shell_width = kernels::inverseShellWidth(k.sp_thres);
+      forEachCandidate(grid, z, [&](unsigned int i) {
+        const float* x = target.positions + 3 * i;
+        const float a =
+            kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
+                                        x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
+        kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2], k.sp_thres,
+                                         inv_shell_width);
+      });
+      kernels::accumulatePointCurvature(mine, sums, z, inv_ell2, kernels::kCurvatureStride);
+    } else {
+      kernels::PointSums sums;
+      kernels::clear(sums);
+      forEachCandidate(grid, z, [&](unsigned int i) {
+        const float* x = target.positions + 3 * i;
+        const float a =
+            kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
+                                        x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
+        kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
+      });
+      if (sums.pairs > 0) kernels::accumulatePoint(mine.moments, sums, z);
+    }
+  }
+  blockReduce(shared, mine, [](kernels::CurvatureSums& a, const kernels::CurvatureSums& b) {
+    kernels::add(a, b);
+  });
+  if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
+}
+
 // Grid build: the cell of every target point and the points per cell.
 __global__ void cellKernel(const float* positions, int count, GridView grid, unsigned int* cell,
                            unsigned int* counts) {
@@ -203,10 +245,12 @@ struct DevicePairSums::Impl {
   DeviceBuffer<kernels::TaylorSums> taylor_partials;
   DeviceBuffer<kernels::MomentSums> moment_total;
   DeviceBuffer<kernels::TaylorSums> taylor_total;
+  DeviceBuffer<kernels::CurvatureSums> curvature_partials, curvature_total;
   float* pinned = nullptr;  // staging for uploads
   std::size_t pinned_capacity = 0;
   kernels::MomentSums* pinned_moments = nullptr;  // the one download of an evaluation
   kernels::TaylorSums* pinned_taylor = nullptr;
+  kernels::CurvatureSums* pinned_curvature = nullptr;
   int count[2] = {0, 0};
   int classes = 0;
   bool target_has_color = false;
@@ -355,12 +399,14 @@ DevicePairSums::DevicePairSums() : impl_(std::make_unique<Impl>()) {
   check(cudaStreamCreateWithFlags(&impl_->stream, cudaStreamNonBlocking), "cudaStreamCreate");
   check(cudaMallocHost(&impl_->pinned_moments, sizeof(kernels::MomentSums)), "cudaMallocHost");
   check(cudaMallocHost(&impl_->pinned_taylor, sizeof(kernels::TaylorSums)), "cudaMallocHost");
+  check(cudaMallocHost(&impl_->pinned_curvature, sizeof(kernels::CurvatureSums)), "cudaMallocHost");
 }
 
 DevicePairSums::~DevicePairSums() {
   if (impl_->pinned) cudaFreeHost(impl_->pinned);
   if (impl_->pinned_moments) cudaFreeHost(impl_->pinned_moments);
   if (impl_->pinned_taylor) cudaFreeHost(impl_->pinned_taylor);
+  if (impl_->pinned_curvature) cudaFreeHost(impl_->pinned_curvature);
   if (impl_->stream) cudaStreamDestroy(impl_->stream);
 }
 
@@ -414,6 +460,19 @@ kernels::TaylorSums DevicePairSums::taylor(const float* pose, const double* xi, 
       static_cast<float>(0.5 / (ell * ell)), 1.0 / (ell * ell), d.taylor_partials.data);
   check(cudaGetLastError(), "taylor kernel");
   return d.sumPartials(d.taylor_partials, blocks, d.taylor_total, d.pinned_taylor);
+}
+
+kernels::CurvatureSums DevicePairSums::curvature(const float* pose, double ell) {
+  Impl& d = *impl_;
+  const int blocks = d.prepare(ell);
+  d.curvature_partials.reserve(blocks);
+  Pose3x4 T;
+  std::copy(pose, pose + 12, T.m);
+  curvatureKernel<<<blocks, kThreads, 0, d.stream>>>(
+      d.targetView(), d.sourceView(), d.grid, d.constants, T, static_cast<float>(0.5 / (ell * ell)),
+      1.0 / (ell * ell), d.curvature_partials.data);
+  check(cudaGetLastError(), "curvature kernel");
+  return d.sumPartials(d.curvature_partials, blocks, d.curvature_total, d.pinned_curvature);
 }
 
 bool cudaDeviceUsable(std::string* why_not) {
