@@ -64,6 +64,17 @@ struct CloudView {
   int count;
 };
 
+// What one evaluation's kernel needs, copied into its device lambda.
+struct Evaluation {
+  int blocks;
+  Pose3x4 pose;
+  CloudView target, source;
+  GridView grid;
+  kernels::KernelConstants k;
+  float inv_two_ell2;
+  double inv_ell2;
+};
+
 // Visits the target points in the cell ranges the query ball around z reaches.
 template <class F>
 __device__ void forEachCandidate(const GridView& grid, const float* z, F&& f) {
@@ -95,96 +106,46 @@ __device__ void blockReduce(Sums* shared, Sums value, Add add) {
   }
 }
 
-__global__ void momentsKernel(CloudView target, CloudView source, GridView grid,
-                              kernels::KernelConstants k, Pose3x4 pose, float inv_two_ell2,
-                              kernels::MomentSums* partial) {
-  __shared__ kernels::MomentSums shared[kThreads];
-  const int j = blockIdx.x * blockDim.x + threadIdx.x;
-  kernels::MomentSums mine;
-  kernels::clear(mine);
-  if (j < source.count) {
-    float z[3];
-    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
-    kernels::PointSums sums;
-    kernels::clear(sums);
-    forEachCandidate(grid, z, [&](unsigned int i) {
-      const float* x = target.positions + 3 * i;
-      const float a =
-          kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
-                                      x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
-      kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
-    });
-    if (sums.pairs > 0) kernels::accumulatePoint(mine, sums, z);
-  }
-  blockReduce(shared, mine,
-              [](kernels::MomentSums& a, const kernels::MomentSums& b) { kernels::add(a, b); });
-  if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
-}
-
-__global__ void taylorKernel(CloudView target, CloudView source, GridView grid,
-                             kernels::KernelConstants k, Pose3x4 pose, Twist xi, float inv_two_ell2,
-                             double inv_ell2, kernels::TaylorSums* partial) {
-  __shared__ kernels::TaylorSums shared[kThreads];
-  const int j = blockIdx.x * blockDim.x + threadIdx.x;
-  kernels::TaylorSums mine;
-  kernels::clear(mine);
-  if (j < source.count) {
-    float z[3];
-    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
-    kernels::TaylorFrame frame;
-    kernels::makeTaylorFrame(z, xi.v, frame);
-    forEachCandidate(grid, z, [&](unsigned int i) {
-      const float* x = target.positions + 3 * i;
-      const float a =
-          kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
-                                      x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
-      if (a > 0.0f) kernels::accumulateTaylorPair(mine, frame, x, z, a, inv_ell2);
-    });
-  }
-  blockReduce(shared, mine,
-              [](kernels::TaylorSums& a, const kernels::TaylorSums& b) { kernels::add(a, b); });
-  if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
-}
-
-__global__ void curvatureKernel(CloudView target, CloudView source, GridView grid,
-                                kernels::KernelConstants k, Pose3x4 pose, float inv_two_ell2,
-                                double inv_ell2, kernels::CurvatureSums* partial) {
-  __shared__ kernels::CurvatureSums shared[kThreads];
-  const int j = blockIdx.x * blockDim.x + threadIdx.x;
-  kernels::CurvatureSums mine;
-  kernels::clear(mine);
-  if (j < source.count) {
-    float z[3];
-    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
-    if (j % kernels::kCurvatureStride == 0) {
-      kernels::PointCurvature sums;
-      kernels::clear(sums);
-      const float inv_shell_width = kernels::inverseShellWidth(k.sp_thres);
-      forEachCandidate(grid, z, [&](unsigned int i) {
-        const float* x = target.positions + 3 * i;
-        const float a =
-            kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
-                                        x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
-        kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2], k.sp_thres,
-                                         inv_shell_width);
-      });
-      kernels::accumulatePointCurvature(mine, sums, z, inv_ell2, kernels::kCurvatureStride);
-    } else {
-      kernels::PointSums sums;
-      kernels::clear(sums);
-      forEachCandidate(grid, z, [&](unsigned int i) {
-        const float* x = target.positions + 3 * i;
-        const float a =
-            kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
-                                        x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres);
-        kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
-      });
-      if (sums.pairs > 0) kernels::accumulatePoint(mine.moments, sums, z);
-    }
-  }
-  blockReduce(shared, mine, [](kernels::CurvatureSums& a, const kernels::CurvatureSums& b) {
-    kernels::add(a, b);
+// Calls f(x, a) for every candidate target point x of source point j (at z), with the pair's
+// retained weight a (0 when not retained).
+template <class F>
+__device__ void forEachPairWeight(const CloudView& target, const CloudView& source,
+                                  const GridView& grid, const kernels::KernelConstants& k, int j,
+                                  const float* z, float inv_two_ell2, F&& f) {
+  forEachCandidate(grid, z, [&](unsigned int i) {
+    const float* x = target.positions + 3 * i;
+    f(x, kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
+                                     x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres));
   });
+}
+
+// Source point j's moment sums over its candidates.
+__device__ kernels::PointSums pointSums(const CloudView& target, const CloudView& source,
+                                        const GridView& grid, const kernels::KernelConstants& k,
+                                        int j, const float* z, float inv_two_ell2) {
+  kernels::PointSums sums;
+  kernels::clear(sums);
+  forEachPairWeight(target, source, grid, k, j, z, inv_two_ell2, [&](const float* x, float a) {
+    kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
+  });
+  return sums;
+}
+
+// One thread a source point: per_point(j, T z_j, sums) adds the point's share to the thread's
+// sums; the block's sums are added in a fixed tree order, one partial a block.
+template <class Sums, class PerPoint>
+__global__ void sourcePointsKernel(CloudView source, Pose3x4 pose, PerPoint per_point,
+                                   Sums* partial) {
+  __shared__ Sums shared[kThreads];
+  const int j = blockIdx.x * blockDim.x + threadIdx.x;
+  Sums mine;
+  kernels::clear(mine);
+  if (j < source.count) {
+    float z[3];
+    kernels::transformPoint(pose.m, source.positions + 3 * j, z);
+    per_point(j, z, mine);
+  }
+  blockReduce(shared, mine, [](Sums& a, const Sums& b) { kernels::add(a, b); });
   if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
 }
 
@@ -387,6 +348,31 @@ struct DevicePairSums::Impl {
     return *pinned_total;
   }
 
+  // The grid for `ell` and the kernel's inputs.
+  Evaluation evaluation(const float* pose, double ell) {
+    Evaluation e;
+    e.blocks = prepare(ell);
+    std::copy(pose, pose + 12, e.pose.m);
+    e.target = targetView();
+    e.source = sourceView();
+    e.grid = grid;
+    e.k = constants;
+    e.inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+    e.inv_ell2 = 1.0 / (ell * ell);
+    return e;
+  }
+
+  // Runs per_point over every source point and returns the summed result (one host wait).
+  template <class Sums, class PerPoint>
+  Sums run(const Evaluation& e, PerPoint per_point, DeviceBuffer<Sums>& partials,
+           DeviceBuffer<Sums>& total, Sums* pinned_total, const char* what) {
+    partials.reserve(e.blocks);
+    sourcePointsKernel<<<e.blocks, kThreads, 0, stream>>>(e.source, e.pose, per_point,
+                                                          partials.data);
+    check(cudaGetLastError(), what);
+    return sumPartials(partials, e.blocks, total, pinned_total);
+  }
+
   CloudView targetView() const {
     return {sorted[0].data, sorted[1].data, sorted[2].data, count[0]};
   }
@@ -436,43 +422,55 @@ void DevicePairSums::setConstants(const kernels::KernelConstants& constants, dou
 
 kernels::MomentSums DevicePairSums::moments(const float* pose, double ell) {
   Impl& d = *impl_;
-  const int blocks = d.prepare(ell);
-  d.moment_partials.reserve(blocks);
-  Pose3x4 T;
-  std::copy(pose, pose + 12, T.m);
-  momentsKernel<<<blocks, kThreads, 0, d.stream>>>(
-      d.targetView(), d.sourceView(), d.grid, d.constants, T, static_cast<float>(0.5 / (ell * ell)),
-      d.moment_partials.data);
-  check(cudaGetLastError(), "moments kernel");
-  return d.sumPartials(d.moment_partials, blocks, d.moment_total, d.pinned_moments);
+  const Evaluation e = d.evaluation(pose, ell);
+  auto per_point = [=] __device__(int j, const float* z, kernels::MomentSums& mine) {
+    const kernels::PointSums sums =
+        pointSums(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2);
+    if (sums.pairs > 0) kernels::accumulatePoint(mine, sums, z);
+  };
+  return d.run(e, per_point, d.moment_partials, d.moment_total, d.pinned_moments, "moments kernel");
 }
 
 kernels::TaylorSums DevicePairSums::taylor(const float* pose, const double* xi, double ell) {
   Impl& d = *impl_;
-  const int blocks = d.prepare(ell);
-  d.taylor_partials.reserve(blocks);
-  Pose3x4 T;
-  std::copy(pose, pose + 12, T.m);
+  const Evaluation e = d.evaluation(pose, ell);
   Twist twist;
   std::copy(xi, xi + 6, twist.v);
-  taylorKernel<<<blocks, kThreads, 0, d.stream>>>(
-      d.targetView(), d.sourceView(), d.grid, d.constants, T, twist,
-      static_cast<float>(0.5 / (ell * ell)), 1.0 / (ell * ell), d.taylor_partials.data);
-  check(cudaGetLastError(), "taylor kernel");
-  return d.sumPartials(d.taylor_partials, blocks, d.taylor_total, d.pinned_taylor);
+  auto per_point = [=] __device__(int j, const float* z, kernels::TaylorSums& mine) {
+    kernels::TaylorFrame frame;
+    kernels::makeTaylorFrame(z, twist.v, frame);
+    forEachPairWeight(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2,
+                      [&](const float* x, float a) {
+                        if (a > 0.0f)
+                          kernels::accumulateTaylorPair(mine, frame, x, z, a, e.inv_ell2);
+                      });
+  };
+  return d.run(e, per_point, d.taylor_partials, d.taylor_total, d.pinned_taylor, "taylor kernel");
 }
 
 kernels::CurvatureSums DevicePairSums::curvature(const float* pose, double ell) {
   Impl& d = *impl_;
-  const int blocks = d.prepare(ell);
-  d.curvature_partials.reserve(blocks);
-  Pose3x4 T;
-  std::copy(pose, pose + 12, T.m);
-  curvatureKernel<<<blocks, kThreads, 0, d.stream>>>(
-      d.targetView(), d.sourceView(), d.grid, d.constants, T, static_cast<float>(0.5 / (ell * ell)),
-      1.0 / (ell * ell), d.curvature_partials.data);
-  check(cudaGetLastError(), "curvature kernel");
-  return d.sumPartials(d.curvature_partials, blocks, d.curvature_total, d.pinned_curvature);
+  const Evaluation e = d.evaluation(pose, ell);
+  // Moments over every source point, the Hessian from every kCurvatureStride-th (as the CPU).
+  auto per_point = [=] __device__(int j, const float* z, kernels::CurvatureSums& mine) {
+    if (j % kernels::kCurvatureStride != 0) {
+      const kernels::PointSums sums =
+          pointSums(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2);
+      if (sums.pairs > 0) kernels::accumulatePoint(mine.moments, sums, z);
+      return;
+    }
+    kernels::PointCurvature sums;
+    kernels::clear(sums);
+    const float inv_shell_width = kernels::inverseShellWidth(e.k.sp_thres);
+    forEachPairWeight(
+        e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2, [&](const float* x, float a) {
+          kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2],
+                                           e.k.sp_thres, inv_shell_width);
+        });
+    kernels::accumulatePointCurvature(mine, sums, z, e.inv_ell2, kernels::kCurvatureStride);
+  };
+  return d.run(e, per_point, d.curvature_partials, d.curvature_total, d.pinned_curvature,
+               "curvature kernel");
 }
 
 bool cudaDeviceUsable(std::string* why_not) {
