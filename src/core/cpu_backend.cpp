@@ -3,10 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace cvo {
 
 namespace {
@@ -142,11 +138,7 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
 }
 
 int CpuBackend::threadCount() const {
-#ifdef _OPENMP
-  return num_threads_ > 0 ? num_threads_ : omp_get_max_threads();
-#else
-  return 1;
-#endif
+  return resolvedThreadCount(num_threads_);
 }
 
 double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {

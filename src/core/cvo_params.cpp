@@ -1,5 +1,9 @@
 #include "cvo_odometry/core/cvo_params.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -121,6 +125,15 @@ BackendChoice parseBackendChoice(const std::string& name) {
   if (name == "cpu") return BackendChoice::kCpu;
   if (name == "cuda") return BackendChoice::kCuda;
   throw std::invalid_argument("unknown backend '" + name + "' (auto, cpu or cuda)");
+}
+
+int resolvedThreadCount(int num_threads) {
+#ifdef _OPENMP
+  return num_threads > 0 ? num_threads : omp_get_max_threads();
+#else
+  (void)num_threads;
+  return 1;
+#endif
 }
 
 }  // namespace cvo

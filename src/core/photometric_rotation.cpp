@@ -7,10 +7,6 @@
 
 #include "cvo_odometry/core/lie_group.hpp"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace cvo {
 
 namespace {
@@ -30,15 +26,6 @@ double medianAbsolute(const std::vector<double>& residuals) {
   const auto middle = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
   std::nth_element(a.begin(), middle, a.end());
   return *middle;
-}
-
-int threadCount(const CvoParams& params) {
-#ifdef _OPENMP
-  return params.num_threads > 0 ? params.num_threads : omp_get_max_threads();
-#else
-  (void)params;
-  return 1;
-#endif
 }
 
 }  // namespace
@@ -69,7 +56,7 @@ PhotometricRotationResult refineRotationPhotometrically(
     points[j] = cloud.position(j).cast<double>();
 
   Eigen::Isometry3d T = reference_from_current;
-  const int threads = threadCount(params);
+  const int threads = resolvedThreadCount(params.num_threads);
   const long count = static_cast<long>(n);
   // Per point (NaN residual: not observed), filled in parallel, then gathered in point order:
   // the same sums whatever the thread count.

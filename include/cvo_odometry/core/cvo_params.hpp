@@ -96,6 +96,9 @@ struct CvoParams {
   double maxKernelWeight() const;
 };
 
+// Threads for `num_threads` (0: OpenMP's default, all cores; 1 without OpenMP).
+int resolvedThreadCount(int num_threads);
+
 std::string toString(StepMethod method);
 std::string toString(BackendChoice backend);
 std::string toString(LostFramePolicy policy);

@@ -110,13 +110,6 @@ CVO_HOST_DEVICE inline void clear(PointSums& p) {
   p.pairs = 0;
 }
 
-CVO_HOST_DEVICE inline void add(PointSums& p, const PointSums& o) {
-  p.weight += o.weight;
-  for (int k = 0; k < 3; ++k)
-    p.offset[k] += o.offset[k];
-  p.pairs += o.pairs;
-}
-
 CVO_HOST_DEVICE inline void clear(CurvatureSums& c) {
   clear(c.moments);
   for (int k = 0; k < 21; ++k)

@@ -61,11 +61,10 @@ class VoxelGrid {
     });
   }
 
-  // The points in sorted order (the slots forEachRange's ranges index) and their indices.
+  // The points in sorted order (the slots forEachRange's ranges index).
   const float* sortedX() const { return xs_.data(); }
   const float* sortedY() const { return ys_.data(); }
   const float* sortedZ() const { return zs_.data(); }
-  const std::uint32_t* sortedIndex() const { return order_.data(); }
 
  private:
   static constexpr float kSparseReach = 1 << 20;
