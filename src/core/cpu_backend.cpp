@@ -71,7 +71,7 @@ CVO_CPU_DISPATCH kernels::PointCurvature curvatureOfCandidates(
     const float dx = xs[c] - zx, dy = ys[c] - zy, dz = zs[c] - zz;
     const float a = kernels::retainedPairWeight(appearance ? appearance[c] : constant, dx, dy, dz,
                                                 inv_two_ell2, sp_thres);
-    const float shell = a > 0.0f && a < shell_top ? a * a * inv_shell_width : 0.0f;
+    const float shell = kernels::shellWeight(a, shell_top, inv_shell_width);
     w += a;
     pairs += a > 0.0f ? 1.0f : 0.0f;
     ox += a * dx;
@@ -256,20 +256,29 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
   built_radius_ = radius_max;
 }
 
-template <class Fill>
-kernels::MomentSums CpuBackend::sumBlocks(Fill&& fill) const {
+template <class Sums, class Fill>
+Sums CpuBackend::sumBlocks(Fill&& fill) const {
   const long block_count = static_cast<long>(blocks_.size());
-  std::vector<kernels::MomentSums> partial(blocks_.size());
+  std::vector<Sums> partial(blocks_.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
   for (long b = 0; b < block_count; ++b) {
     kernels::clear(partial[b]);
     fill(static_cast<std::size_t>(b), partial[b]);
   }
-  kernels::MomentSums total;
+  Sums total;
   kernels::clear(total);
   for (const auto& m : partial)
     kernels::add(total, m);
   return total;
+}
+
+kernels::PointSums CpuBackend::listSums(const Block& block, std::size_t k, const float* z,
+                                        float inv_two_ell2) const {
+  const std::uint32_t first = block.offsets[k];
+  return sumCandidates(block.x.data() + first, block.y.data() + first, block.z.data() + first,
+                       constant_appearance_ ? nullptr : block.appearance.data() + first,
+                       constants_.max_weight, static_cast<int>(block.offsets[k + 1] - first), z,
+                       inv_two_ell2, constants_.sp_thres);
 }
 
 float CpuBackend::appearanceDistance2(std::uint32_t i, std::size_t j) const {
@@ -297,25 +306,14 @@ kernels::MomentSums CpuBackend::moments(const Eigen::Isometry3d& T, double ell) 
   float pose[12];
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
-  const float sp_thres = constants_.sp_thres;
-  const float constant_appearance = constants_.max_weight;
-  const bool constant = constant_appearance_;
   const float* src = source_->positionData().data();
-  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
+  return sumBlocks<kernels::MomentSums>([&](std::size_t b, kernels::MomentSums& m) {
     const Block& block = blocks_[b];
     const std::size_t begin = b * kBlockSize;
-    const std::size_t points = block.offsets.size() - 1;
-    for (std::size_t k = 0; k < points; ++k) {
+    for (std::size_t k = 0; k + 1 < block.offsets.size(); ++k) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * (begin + k), z);
-      const std::uint32_t first = block.offsets[k];
-      const int count = static_cast<int>(block.offsets[k + 1] - first);
-      const float* xs = block.x.data() + first;
-      const float* ys = block.y.data() + first;
-      const float* zs = block.z.data() + first;
-      const float* appearance = constant ? nullptr : block.appearance.data() + first;
-      const kernels::PointSums sums = sumCandidates(xs, ys, zs, appearance, constant_appearance,
-                                                    count, z, inv_two_ell2, sp_thres);
+      const kernels::PointSums sums = listSums(block, k, z, inv_two_ell2);
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
   });
@@ -331,7 +329,7 @@ kernels::MomentSums CpuBackend::sumFromGrid(const Eigen::Isometry3d& T, double e
   toRowMajor3x4(T, pose);
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const float* src = source_->positionData().data();
-  return sumBlocks([&](std::size_t b, kernels::MomentSums& m) {
+  return sumBlocks<kernels::MomentSums>([&](std::size_t b, kernels::MomentSums& m) {
     const std::size_t begin = b * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
     for (std::size_t j = begin; j < end; ++j) {
@@ -389,38 +387,26 @@ kernels::CurvatureSums CpuBackend::curvature(const Eigen::Isometry3d& T, double 
   const double inv_ell2 = 1.0 / (ell * ell);
   const float inv_shell_width = kernels::inverseShellWidth(constants_.sp_thres);
   const float* src = source_->positionData().data();
-  const bool constant = constant_appearance_;
-  const long block_count = static_cast<long>(blocks_.size());
-  std::vector<kernels::CurvatureSums> partial(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
-  for (long b = 0; b < block_count; ++b) {
+  return sumBlocks<kernels::CurvatureSums>([&](std::size_t b, kernels::CurvatureSums& c) {
     const Block& block = blocks_[b];
-    kernels::clear(partial[b]);
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    const std::size_t begin = b * kBlockSize;
     for (std::size_t k = 0; k + 1 < block.offsets.size(); ++k) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * (begin + k), z);
-      const std::uint32_t first = block.offsets[k];
-      const int count = static_cast<int>(block.offsets[k + 1] - first);
-      const float* appearance = constant ? nullptr : block.appearance.data() + first;
-      if ((begin + k) % kernels::kCurvatureStride == 0) {
-        const kernels::PointCurvature sums = curvatureOfCandidates(
-            block.x.data() + first, block.y.data() + first, block.z.data() + first, appearance,
-            constants_.max_weight, count, z, inv_two_ell2, constants_.sp_thres, inv_shell_width);
-        kernels::accumulatePointCurvature(partial[b], sums, z, inv_ell2, kernels::kCurvatureStride);
-      } else {
-        const kernels::PointSums sums = sumCandidates(
-            block.x.data() + first, block.y.data() + first, block.z.data() + first, appearance,
-            constants_.max_weight, count, z, inv_two_ell2, constants_.sp_thres);
-        if (sums.pairs > 0) kernels::accumulatePoint(partial[b].moments, sums, z);
+      if ((begin + k) % kernels::kCurvatureStride != 0) {
+        const kernels::PointSums sums = listSums(block, k, z, inv_two_ell2);
+        if (sums.pairs > 0) kernels::accumulatePoint(c.moments, sums, z);
+        continue;
       }
+      const std::uint32_t first = block.offsets[k];
+      const kernels::PointCurvature sums = curvatureOfCandidates(
+          block.x.data() + first, block.y.data() + first, block.z.data() + first,
+          constant_appearance_ ? nullptr : block.appearance.data() + first, constants_.max_weight,
+          static_cast<int>(block.offsets[k + 1] - first), z, inv_two_ell2, constants_.sp_thres,
+          inv_shell_width);
+      kernels::accumulatePointCurvature(c, sums, z, inv_ell2, kernels::kCurvatureStride);
     }
-  }
-  kernels::CurvatureSums total;
-  kernels::clear(total);
-  for (const auto& c : partial)
-    kernels::add(total, c);
-  return total;
+  });
 }
 
 kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) {
@@ -430,15 +416,10 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const double inv_ell2 = 1.0 / (ell * ell);
   const float* src = source_->positionData().data();
-  const long block_count = static_cast<long>(blocks_.size());
-  std::vector<kernels::TaylorSums> partial(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
-  for (long b = 0; b < block_count; ++b) {
+  return sumBlocks<kernels::TaylorSums>([&](std::size_t b, kernels::TaylorSums& s) {
     const Block& block = blocks_[b];
-    kernels::TaylorSums s{0.0, 0.0, 0.0, 0.0};
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
-    const std::size_t points = block.offsets.size() - 1;
-    for (std::size_t k = 0; k < points; ++k) {
+    const std::size_t begin = b * kBlockSize;
+    for (std::size_t k = 0; k + 1 < block.offsets.size(); ++k) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * (begin + k), z);
       kernels::TaylorFrame frame;
@@ -451,12 +432,7 @@ kernels::TaylorSums CpuBackend::taylor(const Eigen::Isometry3d& T, const Vector6
         if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, inv_ell2);
       }
     }
-    partial[b] = s;
-  }
-  kernels::TaylorSums total{0.0, 0.0, 0.0, 0.0};
-  for (const auto& s : partial)
-    kernels::add(total, s);
-  return total;
+  });
 }
 
 }  // namespace cvo

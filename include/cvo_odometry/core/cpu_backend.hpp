@@ -71,9 +71,12 @@ class CpuBackend : public RegistrationBackend {
   kernels::MomentSums gridMoments(const Eigen::Isometry3d& T, double ell);
   // Scaled appearance distance of target point i and source point j (colour, semantics).
   float appearanceDistance2(std::uint32_t i, std::size_t j) const;
-  // Moments of every block of source points, fill(block, sums), added in block order.
-  template <class Fill>
-  kernels::MomentSums sumBlocks(Fill&& fill) const;
+  // Sums of every block of source points, fill(block, sums), added in block order.
+  template <class Sums, class Fill>
+  Sums sumBlocks(Fill&& fill) const;
+  // The moment sums of point k of `block` (at z) over its candidate list.
+  kernels::PointSums listSums(const Block& block, std::size_t k, const float* z,
+                              float inv_two_ell2) const;
   int threadCount() const;
 
   int num_threads_;

@@ -222,6 +222,12 @@ CVO_HOST_DEVICE inline float inverseShellWidth(float sp_thres) {
   return 4.0f / sp_thres;
 }
 
+// A retained pair's share of the threshold's kink: a^2 / width when a lies in the shell just
+// above sp_thres (below shell_top = sp_thres + width), else 0.
+CVO_HOST_DEVICE inline float shellWeight(float a, float shell_top, float inv_shell_width) {
+  return a > 0.0f && a < shell_top ? a * a * inv_shell_width : 0.0f;
+}
+
 // Adds a pair's weight (0 for a pair not retained) to its source point's curvature sums.
 CVO_HOST_DEVICE inline void accumulateCurvaturePair(PointCurvature& p, float a, float dx, float dy,
                                                     float dz, float sp_thres,
@@ -232,8 +238,7 @@ CVO_HOST_DEVICE inline void accumulateCurvaturePair(PointCurvature& p, float a, 
   p.offset[1] += a * dy;
   p.offset[2] += a * dz;
   p.pairs += a > 0.0f ? 1u : 0u;
-  const float shell =
-      a > 0.0f && a < sp_thres + 1.0f / inv_shell_width ? a * a * inv_shell_width : 0.0f;
+  const float shell = shellWeight(a, sp_thres + 1.0f / inv_shell_width, inv_shell_width);
   for (int k = 0; k < 6; ++k) {
     p.outer[k] += a * o[k];
     p.shell[k] += shell * o[k];
