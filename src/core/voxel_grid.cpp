@@ -6,11 +6,6 @@
 
 namespace cvo {
 
-namespace {
-// Dense grids up to this many cells (16 MB of offsets); beyond, the hash map.
-constexpr double kMaxDenseCells = 4.0e6;
-}  // namespace
-
 std::uint64_t VoxelGrid::key(int x, int y, int z) {
   // 21 bits per axis around an offset: cells of 1 cm still span +-10 km.
   constexpr std::uint64_t kMask = (1u << 21) - 1;
@@ -21,25 +16,10 @@ std::uint64_t VoxelGrid::key(int x, int y, int z) {
 }
 
 void VoxelGrid::build(const float* positions, std::size_t count, float cell_size) {
-  shape_.cell = cell_size;
-  float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = count ? positions[a] : 0.0f;
-    hi[a] = lo[a];
-  }
-  for (std::size_t i = 0; i < count; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], positions[3 * i + a]);
-      hi[a] = std::max(hi[a], positions[3 * i + a]);
-    }
-  }
-  double cells = 1.0;
-  for (int a = 0; a < 3; ++a) {
-    shape_.origin[a] = lo[a];
-    shape_.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size)) + 1;
-    cells *= shape_.dims[a];
-  }
-  dense_ = cells <= kMaxDenseCells;
+  float lo[3], hi[3];
+  kernels::boundingBox(positions, count, lo, hi);
+  const double cells = kernels::shapeOverBox(lo, hi, cell_size, &shape_);
+  dense_ = cells <= kernels::kMaxDenseCells;
 
   std::vector<std::uint64_t> cell_of(count);
   for (std::size_t i = 0; i < count; ++i) {

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <math.h>
+#include <stddef.h>
+
+#include <cstddef>
 
 #include "cvo_odometry/core/pair_kernels.hpp"  // CVO_HOST_DEVICE
 
@@ -15,6 +18,35 @@ struct DenseGridShape {
   float cell;       // edge of a cubic cell (>= the query radius)
   int dims[3];      // cells per axis
 };
+
+// Dense grids up to this many cells (16 MB of offsets); beyond, the CPU hashes its cells and the
+// GPU coarsens them.
+constexpr double kMaxDenseCells = 4.0e6;
+
+// Host side: the bounding box of `count` points (3 floats each); an empty set gives a zero box.
+inline void boundingBox(const float* positions, std::size_t count, float* lo, float* hi) {
+  for (int a = 0; a < 3; ++a)
+    lo[a] = hi[a] = count ? positions[a] : 0.0f;
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = fminf(lo[a], positions[3 * i + a]);
+      hi[a] = fmaxf(hi[a], positions[3 * i + a]);
+    }
+  }
+}
+
+// Host side: cells of edge `cell` from the box's lower corner over [lo, hi]; returns the cell
+// count.
+inline double shapeOverBox(const float* lo, const float* hi, float cell, DenseGridShape* shape) {
+  shape->cell = cell;
+  double cells = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    shape->origin[a] = lo[a];
+    shape->dims[a] = static_cast<int>(floorf((hi[a] - lo[a]) / cell)) + 1;
+    cells *= shape->dims[a];
+  }
+  return cells;
+}
 
 CVO_HOST_DEVICE inline int cellCoordinate(const DenseGridShape& g, float v, int axis) {
   return static_cast<int>(floorf((v - g.origin[axis]) / g.cell));

@@ -17,7 +17,6 @@ namespace cvo {
 namespace {
 
 constexpr int kThreads = 128;  // one source point a thread, one partial sum a block
-constexpr double kMaxDenseCells = 4.0e6;
 
 void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) {
@@ -249,31 +248,15 @@ struct DevicePairSums::Impl {
   void buildGrid(double cell_size) {
     const int n = count[0];
     float lo[3], hi[3];
-    for (int a = 0; a < 3; ++a)
-      lo[a] = hi[a] = n ? host_positions[a] : 0.0f;
-    for (int i = 0; i < n; ++i) {
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], host_positions[3 * i + a]);
-        hi[a] = std::max(hi[a], host_positions[3 * i + a]);
-      }
-    }
+    kernels::boundingBox(host_positions.data(), n, lo, hi);
     // Coarsen the cells when the box is huge (outdoor): still exact, just more points scanned.
-    double edge = cell_size;
-    auto cells = [&](double c) {
-      double total = 1.0;
-      for (int a = 0; a < 3; ++a)
-        total *= std::floor((hi[a] - lo[a]) / c) + 1.0;
-      return total;
-    };
-    while (cells(edge) > kMaxDenseCells)
-      edge *= 1.5;
-    grid.shape.cell = static_cast<float>(edge);
-    std::size_t total = 1;
-    for (int a = 0; a < 3; ++a) {
-      grid.shape.origin[a] = lo[a];
-      grid.shape.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / edge)) + 1;
-      total *= static_cast<std::size_t>(grid.shape.dims[a]);
+    float edge = static_cast<float>(cell_size);
+    double cells = kernels::shapeOverBox(lo, hi, edge, &grid.shape);
+    while (cells > kernels::kMaxDenseCells) {
+      edge *= 1.5f;
+      cells = kernels::shapeOverBox(lo, hi, edge, &grid.shape);
     }
+    const auto total = static_cast<std::size_t>(cells);
     int cell_bits = 1;
     while ((std::size_t{1} << cell_bits) < total)
       ++cell_bits;
