@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
     const int repeat = cli.getInt("repeat", 7);
     const int reference_max = cli.getInt("reference-max-size", 3000);
     cvo::CvoParams base;
-    if (cli.has("preset")) base = cvo::loadCvoParams(cli.get("preset"));
+    if (cli.has("preset"))
+      base = cvo::loadCvoParams(cli.get("preset"), base, cvo::UnknownKeys::kIgnore);
     base.num_threads = cli.getInt("threads", 0);
     std::string default_backends = "cpu";
     std::string why_not;

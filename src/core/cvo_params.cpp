@@ -70,6 +70,18 @@ void CvoParams::validate() const {
   requirePositive(max_angular_speed, "max_angular_speed");
   require(max_lost_frames >= 0, "max_lost_frames must be >= 0");
   require(photometric_iterations >= 1, "photometric_iterations must be >= 1");
+  require(keyframe_min_cosine >= 0.0 && keyframe_min_cosine < 1.0,
+          "keyframe_min_cosine must be in [0, 1)");
+  requirePositive(keyframe_max_translation, "keyframe_max_translation");
+  requirePositive(keyframe_max_rotation, "keyframe_max_rotation");
+  require(min_prior_inliers >= 4, "min_prior_inliers must be >= 4");
+  require(min_prior_inlier_ratio >= 0.0 && min_prior_inlier_ratio <= 1.0,
+          "min_prior_inlier_ratio must be in [0, 1]");
+  requirePositive(guess_disagreement_translation, "guess_disagreement_translation");
+  requirePositive(guess_disagreement_rotation, "guess_disagreement_rotation");
+  requirePositive(track_agreement_px, "track_agreement_px");
+  require(min_track_agreement >= 0.0 && min_track_agreement <= 1.0,
+          "min_track_agreement must be in [0, 1]");
   requirePositive(photometric_max_correction, "photometric_max_correction");
 }
 
@@ -80,51 +92,58 @@ double CvoParams::maxKernelWeight() const {
   return weight;
 }
 
+const std::vector<EnumName<StepMethod>>& enumNames(StepMethod) {
+  static const std::vector<EnumName<StepMethod>> names{{StepMethod::kReference, "reference"},
+                                                       {StepMethod::kProcrustes, "procrustes"}};
+  return names;
+}
+
+const std::vector<EnumName<BackendChoice>>& enumNames(BackendChoice) {
+  static const std::vector<EnumName<BackendChoice>> names{
+      {BackendChoice::kAuto, "auto"}, {BackendChoice::kCpu, "cpu"}, {BackendChoice::kCuda, "cuda"}};
+  return names;
+}
+
+const std::vector<EnumName<LostFramePolicy>>& enumNames(LostFramePolicy) {
+  static const std::vector<EnumName<LostFramePolicy>> names{
+      {LostFramePolicy::kKeepGuess, "keep_guess"},
+      {LostFramePolicy::kPublishNothing, "publish_nothing"},
+      {LostFramePolicy::kReset, "reset"}};
+  return names;
+}
+
+const std::vector<EnumName<ReferenceKind>>& enumNames(ReferenceKind) {
+  static const std::vector<EnumName<ReferenceKind>> names{
+      {ReferenceKind::kKeyframe, "keyframe"}, {ReferenceKind::kPreviousFrame, "previous_frame"}};
+  return names;
+}
+
+const std::vector<EnumName<InitialGuess>>& enumNames(InitialGuess) {
+  static const std::vector<EnumName<InitialGuess>> names{
+      {InitialGuess::kAuto, "auto"},
+      {InitialGuess::kConstantVelocity, "constant_velocity"},
+      {InitialGuess::kFeatures, "features"},
+      {InitialGuess::kIdentity, "identity"}};
+  return names;
+}
+
 std::string toString(StepMethod method) {
-  return method == StepMethod::kReference ? "reference" : "procrustes";
+  return settingText(method);
 }
-
 std::string toString(BackendChoice backend) {
-  switch (backend) {
-    case BackendChoice::kCpu:
-      return "cpu";
-    case BackendChoice::kCuda:
-      return "cuda";
-    default:
-      return "auto";
-  }
+  return settingText(backend);
 }
-
 std::string toString(LostFramePolicy policy) {
-  switch (policy) {
-    case LostFramePolicy::kPublishNothing:
-      return "publish_nothing";
-    case LostFramePolicy::kReset:
-      return "reset";
-    default:
-      return "keep_guess";
-  }
+  return settingText(policy);
 }
-
-LostFramePolicy parseLostFramePolicy(const std::string& name) {
-  if (name == "keep_guess") return LostFramePolicy::kKeepGuess;
-  if (name == "publish_nothing") return LostFramePolicy::kPublishNothing;
-  if (name == "reset") return LostFramePolicy::kReset;
-  throw std::invalid_argument("unknown lost_frame_policy '" + name +
-                              "' (keep_guess, publish_nothing or reset)");
-}
-
 StepMethod parseStepMethod(const std::string& name) {
-  if (name == "reference") return StepMethod::kReference;
-  if (name == "procrustes") return StepMethod::kProcrustes;
-  throw std::invalid_argument("unknown step_method '" + name + "' (reference or procrustes)");
+  return parseEnum<StepMethod>("step_method", name);
 }
-
 BackendChoice parseBackendChoice(const std::string& name) {
-  if (name == "auto") return BackendChoice::kAuto;
-  if (name == "cpu") return BackendChoice::kCpu;
-  if (name == "cuda") return BackendChoice::kCuda;
-  throw std::invalid_argument("unknown backend '" + name + "' (auto, cpu or cuda)");
+  return parseEnum<BackendChoice>("backend", name);
+}
+LostFramePolicy parseLostFramePolicy(const std::string& name) {
+  return parseEnum<LostFramePolicy>("lost_frame_policy", name);
 }
 
 int resolvedThreadCount(int num_threads) {

@@ -38,11 +38,15 @@ PointSelector::PointSelector(const SelectorOptions& options)
   }
 }
 
+const std::vector<EnumName<SelectorKind>>& enumNames(SelectorKind) {
+  static const std::vector<EnumName<SelectorKind>> names{{SelectorKind::kGrid, "grid"},
+                                                         {SelectorKind::kFast, "fast"},
+                                                         {SelectorKind::kMixed, "mixed"}};
+  return names;
+}
+
 SelectorKind parseSelectorKind(const std::string& name) {
-  if (name == "fast") return SelectorKind::kFast;
-  if (name == "grid") return SelectorKind::kGrid;
-  if (name == "mixed") return SelectorKind::kMixed;
-  throw std::invalid_argument("unknown point selector '" + name + "' (fast, grid or mixed)");
+  return parseEnum<SelectorKind>("point_selector", name);
 }
 
 std::vector<cv::Point> PointSelector::fastPixels(const cv::Mat& grey, const cv::Mat& valid,

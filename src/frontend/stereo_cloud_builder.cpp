@@ -8,14 +8,6 @@
 
 namespace cvo {
 
-StereoFrontendOptions kittiStereoFrontendOptions() {
-  StereoFrontendOptions options;
-  options.cloud.min_depth = 1.0;
-  options.cloud.max_depth = 55.0;
-  options.cloud.crop_top_rows = 100;
-  return options;
-}
-
 StereoCloudBuilder::StereoCloudBuilder(const StereoFrontendOptions& options)
     : options_(options), matcher_(options.matcher), cloud_builder_(options.cloud) {
   if (!(options.disparity_scale > 0.0)) {

@@ -3,18 +3,23 @@
 //   TUM:   <ns>/rgb/image_rect_color (bgr8, rgb time), <ns>/rgb/camera_info,
 //          <ns>/depth_registered/image_rect (32FC1 metres, depth time)
 //   KITTI: <ns>/left/image_rect, <ns>/right/image_rect (mono8), <ns>/left|right/camera_info;
-//          stamps are times.txt + 1 s (ROS time 0 means "no stamp")
+//          stamps are times.txt + 1 s (ROS time 0 means "no stamp"; --gt-out writes the ground
+//          truth at the bag's stamps)
+//   both:  /tf_static base_link -> the camera frame, a camera looking along base_link's x axis
 #include <iostream>
 
 #include <cv_bridge/cv_bridge.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/image_encodings.h>
+#include <tf2_msgs/TFMessage.h>
 #include <opencv2/imgproc.hpp>
 
+#include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
+#include "cvo_odometry/ros/ros_conversions.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 
 namespace {
@@ -23,6 +28,8 @@ const char* kUsage =
     "usage: cvo_make_bag (--tum DIR [--camera fr1|fr2|fr3|fx,fy,cx,cy] | --kitti DIR) --out BAG\n"
     "  --ns NAME          topic namespace (/camera for TUM, /stereo for KITTI)\n"
     "  --frame-id NAME    camera frame (camera_rgb_optical_frame / camera_left)\n"
+    "  --base-frame NAME  the frame /tf_static puts the camera in (base_link)\n"
+    "  --gt-out FILE      ground truth (TUM format) at the bag's stamps, for cvo_evaluate\n"
     "  --first N --last N frame range\n";
 
 sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
@@ -35,8 +42,23 @@ sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
   info.D = K.distortion.empty() ? std::vector<double>(5, 0.0) : K.distortion;
   info.K = {K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1};
   info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  info.P = {K.fx, 0, K.cx, tx, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
+  // Unrectified images (TUM's distortion) carry no P: the nodelet then projects through K and D,
+  // as the offline tools do for the same folder.
+  if (K.distortion.empty()) info.P = {K.fx, 0, K.cx, tx, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
   return info;
+}
+
+// base -> camera on /tf_static at the first stamp: the bag plays like a robot with a camera.
+void writeCameraTransform(rosbag::Bag& bag, const std::string& base, const std::string& camera,
+                          const ros::Time& stamp) {
+  tf2_msgs::TFMessage tf;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = base;
+  t.child_frame_id = camera;
+  t.transform = cvo::toTransformMsg(cvo::opticalFrameInBase());
+  tf.transforms.push_back(t);
+  bag.write("/tf_static", stamp, tf);
 }
 
 sensor_msgs::ImagePtr imageMsg(const cv::Mat& image, const std::string& encoding,
@@ -48,17 +70,23 @@ sensor_msgs::ImagePtr imageMsg(const cv::Mat& image, const std::string& encoding
 
 int main(int argc, char** argv) {
   try {
-    const cvo::CommandLine cli(
-        argc, argv, {"tum", "kitti", "camera", "out", "ns", "frame-id", "first", "last"}, {"help"});
+    const cvo::CommandLine cli(argc, argv,
+                               {"tum", "kitti", "camera", "out", "ns", "frame-id", "base-frame",
+                                "gt-out", "first", "last"},
+                               {"help"});
     if (cli.has("help") || (!cli.has("tum") && !cli.has("kitti"))) {
       std::cout << kUsage;
       return cli.has("help") ? 0 : 2;
     }
     rosbag::Bag bag(cli.require("out"), rosbag::bagmode::Write);
     const int first = cli.getInt("first", 0);
+    const std::string base_frame = cli.get("base-frame", "base_link");
     std::size_t written = 0;
+    cvo::Trajectory ground_truth;  // at the bag's stamps
     if (cli.has("tum")) {
       const cvo::TumSequence sequence(cli.get("tum"));
+      const std::string gt_path = cli.get("tum") + "/groundtruth.txt";
+      if (cli.has("gt-out")) ground_truth = cvo::readTumTrajectory(gt_path);
       const std::string ns = cli.get("ns", "/camera");
       const cvo::PinholeIntrinsics K = cvo::tumIntrinsics(cli.get("camera", "fr1"));
       const int last = cli.getInt("last", static_cast<int>(sequence.frames().size()) - 1);
@@ -69,6 +97,8 @@ int main(int argc, char** argv) {
         sequence.load(static_cast<std::size_t>(k), &image, &depth);
         const auto& f = sequence.frames()[static_cast<std::size_t>(k)];
         header.seq = static_cast<uint32_t>(k);
+        if (k == first)
+          writeCameraTransform(bag, base_frame, header.frame_id, ros::Time(f.rgb_stamp));
         header.stamp = ros::Time(f.rgb_stamp);
         bag.write(ns + "/rgb/image_rect_color", header.stamp,
                   imageMsg(image, sensor_msgs::image_encodings::BGR8, header));
@@ -81,6 +111,12 @@ int main(int argc, char** argv) {
       }
     } else {
       const cvo::KittiSequence sequence(cli.get("kitti"));
+      if (cli.has("gt-out")) {
+        cvo::Trajectory poses = cvo::readKittiTrajectory(cli.get("kitti") + "/poses.txt",
+                                                         cli.get("kitti") + "/times.txt");
+        for (const auto& sample : poses.poses())
+          ground_truth.append(sample.stamp + 1.0, sample.pose);
+      }
       const std::string ns = cli.get("ns", "/stereo");
       const auto& calibration = sequence.calibration();
       const int last = cli.getInt("last", static_cast<int>(sequence.size()) - 1);
@@ -93,6 +129,7 @@ int main(int argc, char** argv) {
         cv::cvtColor(right, right, cv::COLOR_BGR2GRAY);
         header.seq = static_cast<uint32_t>(k);
         header.stamp = ros::Time(sequence.stamps()[static_cast<std::size_t>(k)] + 1.0);
+        if (k == first) writeCameraTransform(bag, base_frame, header.frame_id, header.stamp);
         const double tx = -calibration.left.fx * calibration.baseline;
         bag.write(ns + "/left/image_rect", header.stamp,
                   imageMsg(left, sensor_msgs::image_encodings::MONO8, header));
@@ -106,6 +143,11 @@ int main(int argc, char** argv) {
       }
     }
     bag.close();
+    if (cli.has("gt-out")) {
+      cvo::writeTrajectory(cli.get("gt-out"), ground_truth, cvo::TrajectoryFormat::kTum);
+      std::cout << "cvo_make_bag: ground truth at the bag's stamps -> " << cli.get("gt-out")
+                << "\n";
+    }
     std::cout << "cvo_make_bag: " << written << " frames -> " << cli.get("out") << "\n";
     return 0;
   } catch (const std::exception& e) {

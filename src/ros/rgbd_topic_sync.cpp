@@ -31,8 +31,9 @@ void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
                                      const image_transport::TransportHints& hints) {
   StampPairerOptions pairing;
   pairing.tolerance = options_.tolerance;
+  // Learning the offset needs a window of both streams, whatever the subscriber queues hold.
   pairing.queue_size = std::max<std::size_t>(static_cast<std::size_t>(options_.queue_size),
-                                             pairing.bootstrap_frames);
+                                             4 * pairing.bootstrap_frames);
   colour_depth_.emplace(pairing);
   if (options_.with_labels) {
     StampPairerOptions exact = pairing;

@@ -120,6 +120,54 @@ cv::Mat disparityImageFromMsg(const stereo_msgs::DisparityImage& msg) {
   return copyToMat(msg.image, "disparity");
 }
 
+CameraFrame rgbdFrameFromMsgs(const sensor_msgs::Image& image, const sensor_msgs::CameraInfo& info,
+                              const sensor_msgs::Image& depth, const sensor_msgs::Image* labels) {
+  RgbdFrame frame;
+  frame.image = colorImageFromMsg(image);
+  frame.depth = depthImageFromMsg(depth);
+  frame.intrinsics = intrinsicsFromCameraInfo(info);
+  if (labels) frame.semantics = labelImageFromMsg(*labels);
+  return frame;
+}
+
+CameraFrame stereoFrameFromMsgs(const sensor_msgs::Image& left,
+                                const sensor_msgs::CameraInfo& left_info,
+                                const sensor_msgs::Image* right,
+                                const sensor_msgs::CameraInfo* right_info,
+                                const stereo_msgs::DisparityImage* disparity) {
+  StereoFrame frame;
+  frame.left = colorImageFromMsg(left);
+  frame.intrinsics = intrinsicsFromCameraInfo(left_info);
+  if (disparity) {
+    frame.disparity = disparityImageFromMsg(*disparity);
+    frame.baseline = disparity->T;
+  } else {
+    if (!right || !right_info) throw std::invalid_argument("no right image and no disparity");
+    frame.right = colorImageFromMsg(*right);
+    frame.baseline = stereoBaseline(left_info, *right_info);
+  }
+  return frame;
+}
+
+Eigen::Isometry3d opticalFrameInBase() {
+  Eigen::Isometry3d base_from_optical = Eigen::Isometry3d::Identity();
+  base_from_optical.linear() << 0, 0, 1,  // base x: optical z
+      -1, 0, 0,                           // base y: optical -x
+      0, -1, 0;                           // base z: optical -y
+  return base_from_optical;
+}
+
+Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& p) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << p.position.x, p.position.y, p.position.z;
+  const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
+  if (!(q.norm() > 1e-9) || !pose.translation().allFinite()) {
+    throw std::invalid_argument("the pose has no valid orientation or position");
+  }
+  pose.linear() = q.normalized().toRotationMatrix();
+  return pose;
+}
+
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) {
   geometry_msgs::Pose msg;
   msg.position.x = pose.translation().x();
@@ -186,6 +234,90 @@ sensor_msgs::PointCloud2 cloudToMsg(const LabeledCloud& cloud, const Eigen::Isom
     }
   }
   return msg;
+}
+
+nav_msgs::Odometry odometryMsg(const OdometryUpdate& update, const ros::Time& stamp,
+                               const std::string& odom_frame, const std::string& base_frame) {
+  nav_msgs::Odometry odom;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = odom_frame;
+  odom.child_frame_id = base_frame;
+  odom.pose.pose = toPoseMsg(update.base_pose);
+  const Vector6d twist = update.baseTwist();
+  odom.twist.twist.linear.x = twist[0];
+  odom.twist.twist.linear.y = twist[1];
+  odom.twist.twist.linear.z = twist[2];
+  odom.twist.twist.angular.x = twist[3];
+  odom.twist.twist.angular.y = twist[4];
+  odom.twist.twist.angular.z = twist[5];
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      odom.pose.covariance[6 * r + c] = update.pose_covariance(r, c);
+      odom.twist.covariance[6 * r + c] = update.twist_covariance(r, c);
+    }
+  }
+  return odom;
+}
+
+geometry_msgs::TransformStamped odometryTransformMsg(const nav_msgs::Odometry& odometry) {
+  geometry_msgs::TransformStamped tf;
+  tf.header = odometry.header;
+  tf.child_frame_id = odometry.child_frame_id;
+  tf.transform.translation.x = odometry.pose.pose.position.x;
+  tf.transform.translation.y = odometry.pose.pose.position.y;
+  tf.transform.translation.z = odometry.pose.pose.position.z;
+  tf.transform.rotation = odometry.pose.pose.orientation;
+  return tf;
+}
+
+cvo_odometry::CvoIndicator indicatorMsg(const PipelineResult& result, const ros::Time& stamp,
+                                        const std::string& odom_frame,
+                                        const IndicatorExtras& extras) {
+  const OdometryUpdate& update = result.update;
+  cvo_odometry::CvoIndicator indicator;
+  indicator.header.stamp = stamp;
+  indicator.header.frame_id = odom_frame;
+  indicator.first_frame = update.firstFrame();
+  indicator.state = toString(update.state);
+  indicator.trusted = update.trusted();
+  indicator.published = update.has_pose;
+  indicator.lost_frames = static_cast<uint32_t>(update.lost_frames);
+  indicator.attempts = static_cast<uint8_t>(update.attempts);
+  indicator.problem = update.problem;
+  indicator.guess = toString(update.guess);
+  if (result.prior) {
+    indicator.prior_tracks = static_cast<uint32_t>(result.prior->tracks);
+    indicator.prior_inliers = static_cast<uint32_t>(result.prior->inliers);
+    indicator.prior_inlier_ratio = result.prior->inlier_ratio;
+    indicator.prior_problem = result.prior->problem;
+    indicator.prior_ms = result.prior->time_ms;
+  }
+  indicator.track_agreement = update.track_agreement;
+  indicator.new_keyframe = update.new_keyframe;
+  indicator.reference_stamp = update.stamp - update.dt;
+  indicator.indicator = update.report.indicator_after;
+  indicator.indicator_before = update.report.indicator_before;
+  indicator.cosine = update.firstFrame() ? 1.0 : update.cosine;
+  indicator.iterations = update.report.iterations;
+  indicator.initial_lengthscale = update.report.initial_lengthscale;
+  indicator.final_lengthscale = update.report.final_lengthscale;
+  indicator.converged = update.firstFrame() || update.report.converged;
+  indicator.photometric_applied = update.photometric.applied;
+  indicator.photometric_correction_deg = update.photometric.correction_deg;
+  indicator.photometric_skipped = update.photometric.skipped;
+  indicator.registration_ms = update.report.time_ms;
+  indicator.frontend_ms = result.stats.time_ms;
+  indicator.total_ms = result.total_ms;
+  indicator.latency_ms = extras.latency_ms;
+  indicator.dropped_frames = static_cast<uint32_t>(extras.dropped_frames);
+  indicator.source_points = static_cast<uint32_t>(result.cloud ? result.cloud->size() : 0);
+  indicator.target_points = static_cast<uint32_t>(update.reference_points);
+  indicator.backend = update.report.backend;
+  indicator.message = update.firstFrame() ? "first frame"
+                      : !update.report.warning.empty()
+                          ? update.report.message + "; " + update.report.warning
+                          : update.report.message;
+  return indicator;
 }
 
 }  // namespace cvo

@@ -27,15 +27,18 @@ int main(int argc, char** argv) {
                                "save-source"});
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "first-frame"});
     if (cli.has("help")) {
-      std::cout << kUsage << cvo::kSharedOptionsUsage;
+      std::cout << kUsage << cvo::sharedOptionsUsage();
       return 0;
     }
-    const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
+    const cvo::OdometrySettings settings = cvo::settingsFrom(cli);
+    const cvo::CvoParams& params = settings.cvo;
     cvo::LabeledCloud target, source;
     if (cli.has("tum") || cli.has("kitti")) {
       const cvo::SequenceInput input = cvo::openSequence(cli);
-      target = input.cloud(static_cast<std::size_t>(std::stoi(cli.require("target"))), nullptr);
-      source = input.cloud(static_cast<std::size_t>(std::stoi(cli.require("source"))), nullptr);
+      target = cvo::buildCloud(
+          settings, input.frame(static_cast<std::size_t>(std::stoi(cli.require("target")))));
+      source = cvo::buildCloud(
+          settings, input.frame(static_cast<std::size_t>(std::stoi(cli.require("source")))));
     } else {
       target = cvo::readCloud(cli.require("target-cloud"));
       source = cvo::readCloud(cli.require("source-cloud"));

@@ -7,7 +7,6 @@
 #include <iostream>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
-#include "cvo_odometry/core/frame_to_frame_odometry.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/stage_timer.hpp"
@@ -44,12 +43,13 @@ int main(int argc, char** argv) {
     names.insert(names.end(), {"first", "last", "out", "format", "gt", "drift-lengths", "plot"});
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "quiet"});
     if (cli.has("help")) {
-      std::cout << kUsage << cvo::kSharedOptionsUsage;
+      std::cout << kUsage << cvo::sharedOptionsUsage();
       return 0;
     }
-    const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
+    const cvo::OdometrySettings settings = cvo::settingsFrom(cli);
+    const cvo::CvoParams& params = settings.cvo;
     const cvo::SequenceInput input = cvo::openSequence(cli);
-    cvo::FrameToFrameOdometry odometry(params);
+    cvo::OdometryPipeline pipeline(settings);
 
     const std::size_t total = input.stamps.size();
     const std::size_t first = static_cast<std::size_t>(cli.getInt("first", 0));
@@ -58,11 +58,11 @@ int main(int argc, char** argv) {
     if (first > last) throw std::invalid_argument("--first is after --last");
     const bool tty = isatty(STDERR_FILENO) && !cli.has("quiet");
     std::cerr << "cvo_run_sequence: " << input.kind << ", " << (last - first + 1)
-              << " frames, backend " << odometry.registration().backend().name() << ", step "
+              << " frames, backend " << pipeline.backendName() << ", step "
               << cvo::toString(params.step_method) << ", colour "
               << (params.use_color ? "on" : "off") << "\n";
-    if (!odometry.registration().backendNote().empty()) {
-      std::cerr << "cvo_run_sequence: " << odometry.registration().backendNote() << "\n";
+    if (!pipeline.backendNote().empty()) {
+      std::cerr << "cvo_run_sequence: " << pipeline.backendNote() << "\n";
     }
 
     cvo::Trajectory trajectory;
@@ -70,25 +70,22 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     cvo::TrackingTally tally;
     for (std::size_t k = first; k <= last; ++k) {
-      cvo::FrontendStats stats;
-      cvo::OdometryUpdate update;
-      const auto frame_start = std::chrono::steady_clock::now();
-      try {
-        cvo::LabeledCloud cloud = input.cloud(k, &stats);
-        timer.add("frontend", stats.time_ms);
-        update = odometry.process(input.stamps[k], std::move(cloud));
-      } catch (const std::invalid_argument& e) {
-        // A frame the front end cannot use (no valid depth, say) is a lost frame, not the end.
-        update = odometry.processLostFrame(input.stamps[k], e.what());
-      }
-      tally.add(update.state);
-      if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
-      if (update.attempts > 0) {
-        timer.add("registration", update.report.time_ms);
-        if (update.photometric.applied) timer.add("photometric", update.photometric.time_ms);
-        timer.add("total", std::chrono::duration<double, std::milli>(
-                               std::chrono::steady_clock::now() - frame_start)
-                               .count());
+      const auto decode_start = std::chrono::steady_clock::now();
+      const cvo::CameraFrame frame = input.frame(k);
+      timer.add("decode", std::chrono::duration<double, std::milli>(
+                              std::chrono::steady_clock::now() - decode_start)
+                              .count());
+      const cvo::PipelineResult result = pipeline.process(input.stamps[k], frame);
+      const cvo::OdometryUpdate& update = result.update;
+      tally.add(result);
+      if (result.outcome == cvo::FrameOutcome::kProcessed) {
+        if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
+        timer.add("frontend", result.stats.time_ms);
+        if (update.attempts > 0) {
+          timer.add("registration", update.report.time_ms);
+          if (update.photometric.applied) timer.add("photometric", update.photometric.time_ms);
+          timer.add("total", result.total_ms);
+        }
       }
       const std::size_t done = k - first + 1;
       const double elapsed =
@@ -96,18 +93,25 @@ int main(int argc, char** argv) {
       if (tty) {
         progress(done, last - first + 1, done / elapsed);
       } else if (!cli.has("quiet")) {
-        std::cerr << "frame " << k << ": " << stats.selection.selected << " points (FAST "
-                  << stats.selection.fast_threshold << ")";
+        std::cerr << "frame " << k << ": ";
+        if (result.outcome != cvo::FrameOutcome::kProcessed) {
+          std::cerr << (result.outcome == cvo::FrameOutcome::kStale ? "stale" : "skipped") << " ("
+                    << result.why << ")\n";
+          continue;
+        }
+        std::cerr << result.stats.selection.selected << " points";
         if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
                     << std::fixed << update.report.time_ms << " ms, cosine " << std::setprecision(3)
-                    << update.cosine << ", "
+                    << update.cosine << ", guess " << cvo::toString(update.guess) << ", "
                     << (update.report.converged ? "converged" : update.report.message);
         }
         if (update.state != cvo::TrackingState::kTracking) {
           std::cerr << ", " << cvo::toString(update.state);
         }
+        if (update.new_keyframe) std::cerr << ", keyframe";
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
+        if (!result.why.empty()) std::cerr << " [" << result.why << "]";
         std::cerr << "\n";
       }
     }

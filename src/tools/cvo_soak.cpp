@@ -11,7 +11,6 @@
 #include <iostream>
 #include <vector>
 
-#include "cvo_odometry/core/frame_to_frame_odometry.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
 #include "cvo_odometry/tools/tracking_tally.hpp"
@@ -53,10 +52,10 @@ int main(int argc, char** argv) {
     names.insert(names.end(), {"frames", "warmup", "log", "max-growth"});
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help"});
     if (cli.has("help")) {
-      std::cout << kUsage << cvo::kSharedOptionsUsage;
+      std::cout << kUsage << cvo::sharedOptionsUsage();
       return 0;
     }
-    const cvo::CvoParams params = cvo::cvoParamsFrom(cli);
+    const cvo::OdometrySettings settings = cvo::settingsFrom(cli);
     const cvo::SequenceInput input = cvo::openSequence(cli);
     const std::size_t frames = static_cast<std::size_t>(cli.getInt("frames", 3000));
     const std::size_t warmup = static_cast<std::size_t>(cli.getInt("warmup", 200));
@@ -68,23 +67,22 @@ int main(int argc, char** argv) {
       if (!log) throw std::runtime_error("cannot write " + cli.get("log"));
       log << "frame,index,ms,resident_mib,state\n";
     }
-    cvo::FrameToFrameOdometry odometry(params);
+    cvo::OdometryPipeline pipeline(settings);
     const std::size_t n = input.stamps.size();
     const double interval = (input.stamps.back() - input.stamps.front()) / (n - 1);
     std::vector<double> ms(frames), resident(frames);
     cvo::TrackingTally tally;
     for (std::size_t k = 0; k < frames; ++k) {
       const std::size_t index = pingPong(k, n);
-      const auto start = std::chrono::steady_clock::now();
-      const cvo::OdometryUpdate update =
-          odometry.process(input.stamps.front() + k * interval, input.cloud(index, nullptr));
-      ms[k] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                  .count();
+      const cvo::CameraFrame frame = input.frame(index);
+      const cvo::PipelineResult result =
+          pipeline.process(input.stamps.front() + k * interval, frame);
+      ms[k] = result.total_ms;
       resident[k] = residentMiB();
-      tally.add(update.state);
+      tally.add(result);
       if (log.is_open()) {
         log << k << "," << index << "," << std::fixed << std::setprecision(3) << ms[k] << ","
-            << resident[k] << "," << cvo::toString(update.state) << "\n";
+            << resident[k] << "," << cvo::toString(result.update.state) << "\n";
       }
       if (k % 500 == 0) {
         std::cerr << "frame " << k << ": " << std::fixed << std::setprecision(1) << ms[k] << " ms, "
@@ -99,15 +97,15 @@ int main(int argc, char** argv) {
     const double growth = resident.back() - resident[warmup];
     std::cout << std::fixed << std::setprecision(1) << "soak: " << frames << " frames of "
               << input.kind << " (" << n << " frames back and forth), backend "
-              << odometry.registration().backend().name() << "\n";
+              << pipeline.backendName() << "\n";
     tally.print(std::cout);
     std::cout << "resident memory: " << resident[0] << " MiB after frame 0, " << resident[warmup]
               << " MiB after warm-up (frame " << warmup << "), " << resident.back()
               << " MiB at the end (peak after warm-up " << peak_after << " MiB); growth " << growth
               << " MiB\n"
-              << std::setprecision(2) << "ms per frame (odometry): median " << median(ms)
-              << "; first tenth after warm-up " << median(early) << ", last tenth " << median(late)
-              << " (ratio " << median(late) / median(early) << ")\n";
+              << std::setprecision(2) << "ms per frame (pipeline, decoded images in): median "
+              << median(ms) << "; first tenth after warm-up " << median(early) << ", last tenth "
+              << median(late) << " (ratio " << median(late) / median(early) << ")\n";
     if (growth > max_growth) {
       std::cout << "memory grew by more than " << max_growth << " MiB after warm-up\n";
       return 1;

@@ -19,10 +19,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
+// The paper's TUM kernels (the defaults are the RGB-D preset's: ell_min 0.02, colour off).
 CvoParams syntheticParams(bool color) {
   CvoParams p;
   p.backend = cvo::BackendChoice::kCpu;
   p.use_color = color;
+  p.ell_min = 0.05;
+  p.color_ell = 0.15;
   p.ell_first_frame = 0.5;  // identity guess, up to 15 deg / 0.3 m away
   return p;
 }
@@ -284,7 +287,7 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   p.ell_min = 0.5;
   EXPECT_NE(message(p).find("ell_min (0.500000) > ell_init (0.150000)"), std::string::npos);
   p = CvoParams();
-  p.sp_thres = 0.01;  // s^2 s_c^2 = 0.0036
+  p.sp_thres = 0.02;  // s^2 = 0.01
   EXPECT_NE(message(p).find("no pair could count"), std::string::npos);
   p = CvoParams();
   p.min_step = 1.0;

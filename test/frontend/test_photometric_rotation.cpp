@@ -8,12 +8,12 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "cvo_odometry/core/frame_to_frame_odometry.hpp"
+#include "cvo_odometry/core/keyframe_odometry.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/photometric_rotation.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
-#include "cvo_odometry/frontend/frontend_params.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
@@ -33,10 +33,9 @@ struct TumPair {
 
 TumPair loadPair(std::size_t k) {
   const cvo::TumSequence sequence(kTum);
-  cvo::RgbdFrontendOptions options;
-  options.depth_units_per_metre = 5000.0;
-  cvo::loadFrontendParams(kPreset, &options.cloud);
-  cvo::RgbdCloudBuilder builder(options);
+  cvo::OdometrySettings settings = cvo::loadOdometrySettings(kPreset);
+  settings.depth_scale = 5000.0;
+  cvo::RgbdCloudBuilder builder(settings.rgbdOptions());
   auto cloud = [&](std::size_t i) {
     cvo::RgbdFrame f;
     sequence.load(i, &f.image, &f.depth);
@@ -51,8 +50,9 @@ TumPair loadPair(std::size_t k) {
 }
 
 cvo::CvoParams presetParams() {
-  cvo::CvoParams params = cvo::loadCvoParams(kPreset);
+  cvo::CvoParams params = cvo::loadOdometrySettings(kPreset).cvo;
   params.backend = cvo::BackendChoice::kCpu;
+  params.reference = cvo::ReferenceKind::kPreviousFrame;
   return params;
 }
 
@@ -188,7 +188,7 @@ TEST(PhotometricRotation, KeepsTheGuessWhenItCannotOrMustNotCorrect) {
 
 TEST(PhotometricRotation, OdometrySaysWhenTheCloudsCarryNoImage) {
   TumPair pair = loadPair(5);
-  cvo::FrameToFrameOdometry odometry(presetParams());
+  cvo::KeyframeOdometry odometry(presetParams());
   pair.reference.setImage(nullptr);
   odometry.process(0.0, pair.reference);
   const cvo::OdometryUpdate u = odometry.process(1.0 / 30.0, pair.current);
@@ -207,9 +207,9 @@ TEST(PhotometricRotation, OdometryOnTheWholeFixtureBeatsTheDepthOnlyRotation) {
   for (std::size_t k = 0; k + 1 < 37; k += 4) {
     const TumPair pair = loadPair(k);
     cvo::CvoParams params = presetParams();
-    cvo::FrameToFrameOdometry on(params);
+    cvo::KeyframeOdometry on(params);
     params.photometric_rotation = false;
-    cvo::FrameToFrameOdometry off(params);
+    cvo::KeyframeOdometry off(params);
     const double dt = sequence.frames()[k + 1].depth_stamp - sequence.frames()[k].depth_stamp;
     on.process(0.0, pair.reference);
     off.process(0.0, pair.reference);

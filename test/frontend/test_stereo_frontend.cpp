@@ -12,13 +12,20 @@
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/builtin_presets.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
-#include "cvo_odometry/frontend/frontend_params.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "kitti_frames.hpp"
 
 namespace {
+
+// The stereo front end as the kitti_stereo preset sets it up.
+cvo::OdometrySettings kittiSettings() {
+  cvo::OdometrySettings settings;
+  cvo::applyPreset("kitti_stereo", &settings);
+  return settings;
+}
 
 const std::string kData = CVO_TEST_DATA_DIR;
 const std::string kPair = kData + "/kitti_stereo_pair";
@@ -71,7 +78,7 @@ TEST(StereoMatcher, AgreesWithThirdPartyDisparityOnTheKittiPair) {
 TEST(StereoFrontend, GivenDisparityGivesMetricDepthCroppedAndInRange) {
   const cv::Mat left = readGrey(kPair + "/left.png");
   const cv::Mat disparity = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
-  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoCloudBuilder builder(kittiSettings().stereoOptions());
   cvo::StereoFrame frame;
   frame.left = left;
   frame.disparity = disparity;
@@ -95,7 +102,7 @@ TEST(StereoFrontend, GivenDisparityGivesMetricDepthCroppedAndInRange) {
 }
 
 TEST(StereoFrontend, MatchedAndGivenDisparityGiveSimilarDepth) {
-  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoCloudBuilder builder(kittiSettings().stereoOptions());
   cvo::StereoFrame matched;
   matched.left = readGrey(kPair + "/left.png");
   matched.right = readGrey(kPair + "/right.png");
@@ -132,7 +139,7 @@ TEST(DisparityConversion, EncodingsAndInvalidValues) {
 }
 
 TEST(StereoFrontend, BadInputGetsAClearError) {
-  cvo::StereoCloudBuilder builder(cvo::kittiStereoFrontendOptions());
+  cvo::StereoCloudBuilder builder(kittiSettings().stereoOptions());
   cvo::StereoFrame frame;
   frame.left = readGrey(kPair + "/left.png");
   frame.intrinsics = pairIntrinsics();
@@ -177,17 +184,13 @@ TEST(KittiSequence, ReadsCalibrationTimesAndImages) {
 // One real stereo registration (frame 0 -> 1, about 1 m forward) against the official poses.
 TEST(StereoFrontend, StereoCloudsRegisterToGroundTruth) {
   const cvo::KittiSequence sequence(kKitti);
-  cvo::StereoFrontendOptions options = cvo::kittiStereoFrontendOptions();
-  cvo::loadFrontendParams(std::string(CVO_SOURCE_DIR) + "/config/kitti_stereo.yaml",
-                          &options.cloud);
-  cvo::StereoCloudBuilder builder(options);
+  cvo::StereoCloudBuilder builder(kittiSettings().stereoOptions());
   auto cloud = [&](std::size_t k) { return cvo_test::kittiCloud(sequence, builder, k); };
   const auto target = cloud(0), source = cloud(1);
   const auto gt = cvo::readKittiTrajectory(kKitti + "/poses.txt");
   const Eigen::Isometry3d truth = gt[0].pose.inverse() * gt[1].pose;
   ASSERT_GT(truth.translation().norm(), 0.5);
-  cvo::CvoParams params =
-      cvo::loadCvoParams(std::string(CVO_SOURCE_DIR) + "/config/kitti_stereo.yaml");
+  cvo::CvoParams params = kittiSettings().cvo;
   params.backend = cvo::BackendChoice::kCpu;
   cvo::CvoRegistration registration(params);
   const auto result = registration.align(target, source, Eigen::Isometry3d::Identity(), true);

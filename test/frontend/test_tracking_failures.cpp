@@ -1,4 +1,4 @@
-// Tracking-failure detection and recovery of FrameToFrameOdometry on real frames through the
+// Tracking-failure detection and recovery of KeyframeOdometry on real frames through the
 // front end: frames that do not overlap, a blank image, no valid depth and a large jump are
 // flagged and never reported as trusted poses; the policies and the recovery do what they say.
 #include <gtest/gtest.h>
@@ -8,13 +8,13 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "cvo_odometry/core/frame_to_frame_odometry.hpp"
+#include "cvo_odometry/core/keyframe_odometry.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/empty_frame_error.hpp"
-#include "cvo_odometry/frontend/frontend_params.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
@@ -22,7 +22,7 @@
 
 namespace {
 
-using cvo::FrameToFrameOdometry;
+using cvo::KeyframeOdometry;
 using cvo::LabeledCloud;
 using cvo::OdometryUpdate;
 using cvo::TrackingState;
@@ -32,8 +32,9 @@ const std::string kConfig = std::string(CVO_SOURCE_DIR) + "/config/";
 constexpr double kFrame = 1.0 / 30.0;
 
 cvo::CvoParams preset(const std::string& name) {
-  cvo::CvoParams params = cvo::loadCvoParams(kConfig + name);
+  cvo::CvoParams params = cvo::loadOdometrySettings(kConfig + name).cvo;
   params.backend = cvo::BackendChoice::kCpu;
+  params.reference = cvo::ReferenceKind::kPreviousFrame;  // these cases are frame to frame
   return params;
 }
 
@@ -51,10 +52,9 @@ cvo::CvoParams colourKernelPreset() {
 class TumFrames {
  public:
   TumFrames() : sequence_(kData + "/tum_fr1_xyz") {
-    cvo::RgbdFrontendOptions options;
-    options.depth_units_per_metre = 5000.0;
-    cvo::loadFrontendParams(kConfig + "tum_rgbd.yaml", &options.cloud);
-    builder_ = std::make_unique<cvo::RgbdCloudBuilder>(options);
+    cvo::OdometrySettings settings = cvo::loadOdometrySettings(kConfig + "tum_rgbd.yaml");
+    settings.depth_scale = 5000.0;
+    builder_ = std::make_unique<cvo::RgbdCloudBuilder>(settings.rgbdOptions());
   }
   cvo::RgbdFrame frame(std::size_t k) const {
     cvo::RgbdFrame f;
@@ -83,7 +83,7 @@ void print(const char* what, const OdometryUpdate& u) {
 
 TEST(TrackingFailures, TheWholeTumFixtureTracksWithoutAFalseAlarm) {
   const TumFrames tum;
-  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  KeyframeOdometry odometry(preset("tum_rgbd.yaml"));
   double lowest_cosine = 1.0;
   for (std::size_t k = 0; k < 37; ++k) {
     const OdometryUpdate u = odometry.process(k * kFrame, tum.cloud(k));
@@ -97,7 +97,7 @@ TEST(TrackingFailures, TheWholeTumFixtureTracksWithoutAFalseAlarm) {
 
 TEST(TrackingFailures, ABlankImageIsFlaggedNotTrusted) {
   const TumFrames tum;
-  FrameToFrameOdometry odometry(colourKernelPreset());
+  KeyframeOdometry odometry(colourKernelPreset());
   odometry.process(0.0, tum.cloud(0));
   const OdometryUpdate good = odometry.process(kFrame, tum.cloud(1));
   ASSERT_EQ(good.state, TrackingState::kTracking);
@@ -121,7 +121,7 @@ TEST(TrackingFailures, ABlankImageIsFlaggedNotTrusted) {
 
 TEST(TrackingFailures, NoValidDepthIsALostFrame) {
   const TumFrames tum;
-  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  KeyframeOdometry odometry(preset("tum_rgbd.yaml"));
   odometry.process(0.0, tum.cloud(0));
   odometry.process(kFrame, tum.cloud(1));
   cvo::RgbdFrame zero = tum.frame(2);
@@ -147,7 +147,7 @@ TEST(TrackingFailures, NoValidDepthIsALostFrame) {
 TEST(TrackingFailures, ALargeJumpIsFlagged) {
   // Frames 0 and 36 are 0.39 m and 10 deg apart; stamped one frame apart that is 12 m/s.
   const TumFrames tum;
-  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  KeyframeOdometry odometry(preset("tum_rgbd.yaml"));
   odometry.process(0.0, tum.cloud(0));
   const OdometryUpdate u = odometry.process(kFrame, tum.cloud(36));
   print("jump", u);
@@ -158,8 +158,8 @@ TEST(TrackingFailures, ALargeJumpIsFlagged) {
 TEST(TrackingFailures, StereoFramesWithoutOverlapAreFlagged) {
   // KITTI 06 frame 0, then the KITTI 00 pair (another road): nothing in common.
   const cvo::KittiSequence sequence(kData + "/kitti_06_stereo");
-  cvo::StereoFrontendOptions options = cvo::kittiStereoFrontendOptions();
-  cvo::loadFrontendParams(kConfig + "kitti_stereo.yaml", &options.cloud);
+  const cvo::StereoFrontendOptions options =
+      cvo::loadOdometrySettings(kConfig + "kitti_stereo.yaml").stereoOptions();
   cvo::StereoCloudBuilder builder(options);
   auto kitti06 = [&](std::size_t k) { return cvo_test::kittiCloud(sequence, builder, k); };
   cvo::StereoFrame other;
@@ -168,7 +168,7 @@ TEST(TrackingFailures, StereoFramesWithoutOverlapAreFlagged) {
   other.intrinsics = cvo_test::pairIntrinsics();
   other.baseline = cvo_test::kPairBaseline;
 
-  FrameToFrameOdometry odometry(preset("kitti_stereo.yaml"));
+  KeyframeOdometry odometry(preset("kitti_stereo.yaml"));
   odometry.process(0.0, kitti06(0));
   const OdometryUpdate good = odometry.process(0.1, kitti06(1));
   print("kitti 0-1", good);
@@ -194,7 +194,7 @@ TEST(TrackingFailures, BlackImageUnderTheGeometricPreset) {
   // Depth still real: CVO tracks the frame by geometry; the photometric stage sees images that
   // do not match and keeps CVO's rotation instead of fitting noise.
   const TumFrames tum;
-  FrameToFrameOdometry odometry(preset("tum_rgbd.yaml"));
+  KeyframeOdometry odometry(preset("tum_rgbd.yaml"));
   odometry.process(0.0, tum.cloud(0));
   const OdometryUpdate good = odometry.process(kFrame, tum.cloud(1));
   ASSERT_TRUE(good.photometric.applied) << good.photometric.skipped;
@@ -213,7 +213,7 @@ TEST(TrackingFailures, PublishNothingReportsNoPoseForALostFrame) {
   const TumFrames tum;
   cvo::CvoParams params = colourKernelPreset();
   params.lost_frame_policy = cvo::LostFramePolicy::kPublishNothing;
-  FrameToFrameOdometry odometry(params);
+  KeyframeOdometry odometry(params);
   odometry.process(0.0, tum.cloud(0));
   cvo::RgbdFrame blank = tum.frame(1);
   blank.image.setTo(cv::Scalar::all(255));
@@ -229,7 +229,7 @@ TEST(TrackingFailures, ResetRestartsFromTheFrameAndHoldsThePose) {
   const TumFrames tum;
   cvo::CvoParams params = preset("tum_rgbd.yaml");
   params.lost_frame_policy = cvo::LostFramePolicy::kReset;
-  FrameToFrameOdometry odometry(params);
+  KeyframeOdometry odometry(params);
   odometry.process(0.0, tum.cloud(0));
   const OdometryUpdate before = odometry.process(kFrame, tum.cloud(1));
   const OdometryUpdate jump = odometry.process(2 * kFrame, tum.cloud(36));
@@ -246,7 +246,7 @@ TEST(TrackingFailures, TooManyLostFramesInARowRestartTracking) {
   const TumFrames tum;
   cvo::CvoParams params = preset("tum_rgbd.yaml");
   params.max_lost_frames = 2;
-  FrameToFrameOdometry odometry(params);
+  KeyframeOdometry odometry(params);
   odometry.process(0.0, tum.cloud(0));
   odometry.process(kFrame, tum.cloud(1));
   EXPECT_EQ(odometry.processLostFrame(2 * kFrame, "no depth").state, TrackingState::kLost);

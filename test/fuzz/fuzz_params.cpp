@@ -1,5 +1,5 @@
 // libFuzzer target: arbitrary text through every parameter and text-file reader (CVO presets,
-// the front end's preset keys, TUM and KITTI trajectories, time stamps). Each may refuse the
+// the whole settings table, TUM and KITTI trajectories, time stamps). Each may refuse the
 // input with the errors it documents; anything else (a crash, a sanitizer report, another
 // exception) is a finding.
 #include <cstddef>
@@ -11,7 +11,7 @@
 #include "cvo_odometry/core/format_error.hpp"
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
-#include "cvo_odometry/frontend/frontend_params.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
 
 namespace {
 
@@ -34,8 +34,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   });
   refuseCleanly([&] {
     std::istringstream in(text);
-    cvo::CloudBuilderOptions options;
-    cvo::parseFrontendParams(in, "fuzz", &options);
+    cvo::OdometrySettings settings;
+    cvo::readSettings(in, "fuzz", &settings);
   });
   refuseCleanly([&] {
     std::istringstream in(text);

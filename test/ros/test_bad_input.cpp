@@ -75,11 +75,12 @@ TEST_F(BadInput, MalformedInputIsSkippedFailuresAreFlaggedAndTrackingResumes) {
   EXPECT_TRUE(indicator(2).published);
   EXPECT_EQ(indicator(2).problem, "no pixel has valid depth");
 
-  // Valid depth in a 10x10 patch only: too few points to track.
+  // Valid depth in a 10x10 patch only: too few points to track. (A new colour image: one
+  // repeating the previous frame's would be a stale frame, skipped.)
   cv::Mat patch(480, 640, CV_32FC1, cv::Scalar(0));
   depths_.at(4)(cv::Rect(300, 200, 10, 10)).copyTo(patch(cv::Rect(300, 200, 10, 10)));
   t = next();
-  publish(colour(4, t), depthFrom(patch, t));
+  publish(colour(5, t), depthFrom(patch, t));
   ASSERT_EQ(waitFor(4), 4u);
   EXPECT_EQ(indicator(3).state, "lost");
   EXPECT_NE(indicator(3).problem.find("too few points"), std::string::npos) << indicator(3).problem;

@@ -2,8 +2,11 @@
 // odometry and indicator messages and checks them against the fixture's ground truth.
 // Parameters (private): ground_truth, ground_truth_times (KITTI), stamp_offset (s added to the
 // ground truth's stamps, as cvo_make_bag does for KITTI), frames (expected), min_frames (fewest
-// accepted, e.g. when a synchronization policy may drop a pair), max_final_error_m, max_rpe_m and max_rpe_deg (per
-// frame) or max_rpe_mps and max_rpe_dps (per second), timeout_s, nearest_association.
+// accepted, e.g. when a synchronization policy may drop a pair), max_final_error_m, max_rpe_m and
+// max_rpe_deg (per frame) or max_rpe_mps and max_rpe_dps (per second), timeout_s,
+// nearest_association, camera_frame (base_link <- camera from TF turns the base poses into the
+// camera's, which the ground truth has), runner_trajectory (cvo_run_sequence's trajectory of the
+// same frames: the nodelet must give the same poses, within runner_tolerance_m).
 #include <gtest/gtest.h>
 
 #include <mutex>
@@ -16,6 +19,7 @@
 #include "cvo_odometry/CvoIndicator.h"
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/ros/ros_conversions.hpp"
 #include "rostest_main.hpp"
 
 namespace {
@@ -107,9 +111,35 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   // TF odom -> base_link available at the last stamp.
   EXPECT_TRUE(tf_buffer.canTransform("odom", "base_link", last.header.stamp, ros::Duration(2.0)));
 
+  // The camera's poses: base poses composed with base <- camera (the bag's /tf_static).
+  std::string camera_frame;
+  ASSERT_TRUE(pnh.getParam("camera_frame", camera_frame));
+  geometry_msgs::TransformStamped base_from_camera;
+  ASSERT_NO_THROW(base_from_camera = tf_buffer.lookupTransform("base_link", camera_frame,
+                                                               ros::Time(0), ros::Duration(5.0)));
+  const Eigen::Isometry3d B = cvo::fromTransformMsg(base_from_camera.transform);
   cvo::Trajectory estimate;
   for (const auto& msg : collected.odometry)
-    estimate.append(msg.header.stamp.toSec() - offset, poseOf(msg));
+    estimate.append(msg.header.stamp.toSec() - offset, poseOf(msg) * B);
+
+  // The nodelet and the offline runner run the same pipeline: the same poses on the same frames.
+  std::string runner_path;
+  if (pnh.getParam("runner_trajectory", runner_path)) {
+    double tolerance = 1e-6;
+    pnh.param("runner_tolerance_m", tolerance, tolerance);
+    const cvo::Trajectory runner =
+        cvo::readTrajectory(runner_path, cvo::detectTrajectoryFormat(runner_path), gt_times);
+    ASSERT_EQ(runner.size(), estimate.size());
+    double largest = 0.0;
+    for (std::size_t k = 0; k < runner.size(); ++k) {
+      EXPECT_NEAR(runner[k].stamp, estimate[k].stamp, 1e-6);
+      const Eigen::Isometry3d nodelet = estimate[0].pose.inverse() * estimate[k].pose;
+      const Eigen::Isometry3d offline = runner[0].pose.inverse() * runner[k].pose;
+      largest = std::max(largest, (nodelet.matrix() - offline.matrix()).cwiseAbs().maxCoeff());
+    }
+    std::cout << "largest difference from the runner's poses: " << largest << "\n";
+    EXPECT_LT(largest, tolerance);
+  }
   const cvo::Trajectory ground_truth =
       cvo::readTrajectory(gt_path, cvo::detectTrajectoryFormat(gt_path), gt_times);
   // Final pose relative to the first, against the ground truth's.

@@ -3,6 +3,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include "cvo_odometry/core/settings_table.hpp"
 
 namespace cvo {
 
@@ -13,6 +16,19 @@ enum class StepMethod {
 
 enum class BackendChoice { kAuto, kCpu, kCuda };
 
+// What a frame is registered to: the keyframe (changed when overlap or distance demand it) or
+// the previous good frame.
+enum class ReferenceKind { kKeyframe, kPreviousFrame };
+
+// Where a registration starts (see KeyframeOdometry).
+enum class InitialGuess {
+  kAuto,              // the feature prior when confident (both when it and constant velocity
+                      // disagree), else constant velocity
+  kConstantVelocity,  // the last motion, scaled to the interval
+  kFeatures,          // the feature prior when confident, else constant velocity
+  kIdentity           // no motion since the previous frame
+};
+
 // What frame-to-frame odometry does with a frame it judges lost (see FrameToFrameOdometry).
 enum class LostFramePolicy {
   kKeepGuess,       // report the constant-velocity guess, flagged, with a grown covariance
@@ -20,17 +36,21 @@ enum class LostFramePolicy {
   kReset            // restart tracking from the frame, holding the last pose
 };
 
+// Every parameter of the core. Names, ranges and meanings: the settings table
+// (cvo_settings.hpp, README "Parameters"). Defaults: the RGB-D preset (a Kinect-class camera at
+// 30 Hz): the paper's TUM kernels with ell_min 0.02, geometry only, then the photometric stage;
+// config/*.yaml state only what they change.
 struct CvoParams {
   // Geometric kernel k(x, z) = sigma^2 exp(-|x - z|^2 / (2 ell^2)).
-  double ell_init = 0.15;         // lengthscale at the start of a registration (m)
-  double ell_min = 0.05;          // smallest lengthscale of the annealing (m)
-  double ell_first_frame = 0.15;  // ell_init for the first pair of a sequence (identity guess)
-  double sigma = 0.1;             // amplitude s
-  double sp_thres = 0.003;        // a pair counts only if its kernel product exceeds this
+  double ell_init = 0.15;
+  double ell_min = 0.02;
+  double ell_first_frame = 0.15;
+  double sigma = 0.1;
+  double sp_thres = 0.003;
 
   // Appearance kernels s_V^2 exp(-|u - v|^2 / (2 ell_V^2)), multiplied into the pair weight.
-  bool use_color = true;
-  double color_ell = 0.15;
+  bool use_color = false;
+  double color_ell = 0.3;
   double color_sigma = 0.6;
   bool use_semantics = false;
   double semantic_ell = 0.1;
@@ -45,50 +65,60 @@ struct CvoParams {
   int indicator_window = 5;
   double indicator_tolerance = 0.02;
 
-  // Step and convergence.
   StepMethod step_method = StepMethod::kProcrustes;
-  double min_step = 1e-5;  // Taylor step clamp (reference method)
+  double min_step = 1e-5;
   double max_step = 0.8;
-  double eps_2 = 1.2e-5;  // stop when |log(increment)| < eps_2 (at ell_min for Procrustes)
+  double eps_2 = 1.2e-5;
   int max_iterations = 2000;
   // Procrustes schedule: converge loosely at each lengthscale (|step| < level_tolerance * ell),
   // then ell <- max(ell * schedule_decay, ell_min); stop on eps_2 only at ell_min.
   double schedule_decay = 0.7;
   double level_tolerance = 0.01;
-  // At lengthscales above ell_min use every k-th point of each cloud, k ~ ell / ell_min, so that
-  // pairs per iteration stay near the finest level's; the finest level uses every point.
   bool subsample_coarse_levels = true;
-  // Largest stretch of the Procrustes step while F keeps rising (1: plain MM steps).
   double max_overrelaxation = 2.0;
-  // Iterations after which a coarse level ends even if its steps are not yet small.
   int max_level_iterations = 30;
-  // At ell_min, Newton steps (analytic gradient and Hessian of sum (a - sp_thres)_+) where the
-  // Hessian is negative definite and the step stays within 10x the MM step; after the first
-  // Newton step that F does not follow upwards, MM steps only.
+  // Newton steps (analytic gradient and Hessian of sum (a - sp_thres)_+) where the Hessian is
+  // negative definite and the step stays within 10x the MM step; after the first Newton step
+  // that F does not follow upwards, MM steps only.
   bool newton_at_ell_min = true;
 
-  // Photometric rotation stage after CVO (see photometric_rotation.hpp): needs clouds that carry
-  // their image (the RGB-D front end attaches it). Gauss-Newton iterations per image level; a
-  // correction above photometric_max_correction (deg) is refused and CVO's rotation kept.
-  bool photometric_rotation = false;
+  // The photometric rotation stage after CVO (photometric_rotation.hpp); needs clouds that
+  // carry their image (the RGB-D front end attaches it).
+  bool photometric_rotation = true;
   int photometric_iterations = 10;
   double photometric_max_correction = 2.0;
 
   BackendChoice backend = BackendChoice::kAuto;
-  int num_threads = 0;  // 0: all cores
+  int num_threads = 0;
 
-  // Tracking quality, judged per frame by FrameToFrameOdometry. A registration is good when it
-  // converged, the cosine of the two functions at its final lengthscale is >= min_cosine, both
-  // clouds have >= min_tracking_points and its motion is within the speed limits over the
-  // frame interval. A bad one is retried from identity with the first-frame lengthscale; if that
-  // fails too the frame is lost and lost_frame_policy applies. After max_lost_frames lost frames
-  // in a row tracking restarts (as kReset).
-  double min_cosine = 0.3;
+  // Tracking quality, judged per frame (tracking_check.hpp): a registration is good when it
+  // converged, its cosine is >= min_cosine, both clouds have >= min_tracking_points and its
+  // motion is within the speed limits over the frame interval.
+  double min_cosine = 0.5;
   int min_tracking_points = 300;
-  double max_linear_speed = 5.0;     // m/s
-  double max_angular_speed = 180.0;  // deg/s
+  double max_linear_speed = 5.0;
+  double max_angular_speed = 180.0;
   LostFramePolicy lost_frame_policy = LostFramePolicy::kKeepGuess;
   int max_lost_frames = 5;
+
+  // Keyframes: a new one when the cosine to it falls below keyframe_min_cosine, or the camera
+  // has moved or turned beyond the bounds since it (README "Keyframes").
+  ReferenceKind reference = ReferenceKind::kPreviousFrame;
+  double keyframe_min_cosine = 0.8;
+  double keyframe_max_translation = 0.1;  // m
+  double keyframe_max_rotation = 5.0;     // deg
+
+  // The motion guess and the feature tracks' check (README "Fast motion").
+  InitialGuess initial_guess = InitialGuess::kAuto;
+  bool forget_motion = false;  // no constant-velocity guess: as after a restart (tests, bench)
+  int min_prior_inliers = 30;
+  double min_prior_inlier_ratio = 0.5;
+  double guess_disagreement_translation = 0.05;  // m
+  double guess_disagreement_rotation = 2.0;      // deg
+  // A confident prior (min_prior_inliers, min_prior_inlier_ratio) judges every registration:
+  // at least min_track_agreement of its inliers within track_agreement_px.
+  double track_agreement_px = 3.0;
+  double min_track_agreement = 0.5;
 
   // Throws std::invalid_argument naming the first parameter that makes no sense.
   void validate() const;
@@ -98,6 +128,13 @@ struct CvoParams {
 
 // Threads for `num_threads` (0: OpenMP's default, all cores; 1 without OpenMP).
 int resolvedThreadCount(int num_threads);
+
+// Value names, for the settings table (settings_table.hpp: settingText, parseEnum).
+const std::vector<EnumName<StepMethod>>& enumNames(StepMethod);
+const std::vector<EnumName<BackendChoice>>& enumNames(BackendChoice);
+const std::vector<EnumName<LostFramePolicy>>& enumNames(LostFramePolicy);
+const std::vector<EnumName<ReferenceKind>>& enumNames(ReferenceKind);
+const std::vector<EnumName<InitialGuess>>& enumNames(InitialGuess);
 
 std::string toString(StepMethod method);
 std::string toString(BackendChoice backend);

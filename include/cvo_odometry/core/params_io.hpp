@@ -1,8 +1,9 @@
-// CvoParams from the flat "key: value" YAML presets in config/ (the same keys the nodelet reads
-// as ROS parameters), and back to text for logging the effective values.
+// CvoParams from the flat "key: value" YAML presets in config/ and back to text, through the
+// settings table (cvo_settings.hpp). A full preset also carries the front end's keys: the
+// ROS-free tools that read only the core skip them (UnknownKeys::kIgnore); everyone else reads
+// the whole aggregate (frontend/odometry_settings.hpp).
 #pragma once
 
-#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -11,27 +12,18 @@
 
 namespace cvo {
 
-// Sets one parameter from its text form; throws std::invalid_argument for an unknown key or a
-// value of the wrong type.
+// Sets one parameter from its text form; throws std::invalid_argument for an unknown key, a
+// value of the wrong form or one outside its range.
 void setCvoParam(CvoParams& params, const std::string& key, const std::string& value);
 std::vector<std::string> cvoParamNames();
 
-// Reads "key: value" lines ('#' comments, blank lines) and calls `apply` for each; a malformed
-// line, a duplicate key, or std::invalid_argument from `apply` throws FormatError naming the
-// source and line.
-void parseKeyValueLines(std::istream& in, const std::string& source_name,
-                        const std::function<void(const std::string&, const std::string&)>& apply);
-
-// The keys a preset may carry for the front end (point_selector, min_points, max_points,
-// min_depth, max_depth, crop_top_rows): the front end reads them, the core skips them.
-const std::vector<std::string>& frontendPresetKeys();
-
-// CvoParams from a preset; unknown keys and bad values throw FormatError naming the source and
-// line. The front end's keys are skipped. Keys not in the text keep `base`'s values. The result
-// is validated.
+// CvoParams from a preset; bad keys and values throw FormatError naming the source and line.
+// Keys not in the text keep `base`'s values. The result is validated.
 CvoParams parseCvoParams(std::istream& in, const std::string& source_name,
-                         const CvoParams& base = CvoParams());
-CvoParams loadCvoParams(const std::string& path, const CvoParams& base = CvoParams());
+                         const CvoParams& base = CvoParams(),
+                         UnknownKeys unknown = UnknownKeys::kError);
+CvoParams loadCvoParams(const std::string& path, const CvoParams& base = CvoParams(),
+                        UnknownKeys unknown = UnknownKeys::kError);
 
 void writeCvoParams(std::ostream& out, const CvoParams& params);
 

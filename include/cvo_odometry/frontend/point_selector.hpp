@@ -7,13 +7,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "cvo_odometry/core/settings_table.hpp"
+
 namespace cvo {
 
 // kMixed: half the points FAST corners, half a uniform grid.
 enum class SelectorKind { kFast, kGrid, kMixed };
 
 struct SelectorOptions {
-  SelectorKind kind = SelectorKind::kFast;
+  SelectorKind kind = SelectorKind::kGrid;
   int min_points = 3000;
   int max_points = 15000;
   int initial_fast_threshold = 9;
@@ -47,6 +49,7 @@ class PointSelector {
   int threshold_;  // carried to the next frame: consecutive frames need similar thresholds
 };
 
+const std::vector<EnumName<SelectorKind>>& enumNames(SelectorKind);
 SelectorKind parseSelectorKind(const std::string& name);
 
 }  // namespace cvo

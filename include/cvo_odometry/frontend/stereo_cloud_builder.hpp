@@ -12,11 +12,8 @@ namespace cvo {
 struct StereoFrontendOptions {
   StereoMatcherOptions matcher;
   double disparity_scale = 1.0;  // stored disparity value -> pixels (given disparity images)
-  CloudBuilderOptions cloud;     // stereo defaults: see kittiStereoFrontendOptions()
+  CloudBuilderOptions cloud;
 };
-
-// KITTI-like defaults: top 100 rows cropped, 55 m maximum range, 3k..15k points.
-StereoFrontendOptions kittiStereoFrontendOptions();
 
 struct StereoFrame {
   cv::Mat left;       // 8-bit BGR or grey, rectified

@@ -11,24 +11,25 @@
 #include <message_filters/synchronizer.h>
 #include <ros/duration.h>
 
+#include "cvo_odometry/core/settings_table.hpp"
+
 namespace cvo {
 
 // exact: equal stamps; approximate: message_filters' nearest-stamp policy; ordered: colour and
-// depth paired in order with a learned stamp offset (RGB-D only, see OrderedStampPairer).
-enum class SyncPolicy { kExact, kApproximate, kOrdered };
+// depth paired in order with a learned stamp offset (RGB-D only, see OrderedStampPairer); auto:
+// ordered for RGB-D, exact for stereo.
+enum class SyncPolicy { kAuto, kExact, kApproximate, kOrdered };
 
-inline SyncPolicy parseSyncPolicy(const std::string& name) {
-  if (name == "exact") return SyncPolicy::kExact;
-  if (name == "approximate") return SyncPolicy::kApproximate;
-  if (name == "ordered") return SyncPolicy::kOrdered;
-  throw std::invalid_argument("sync_policy must be exact, approximate or ordered, not '" + name +
-                              "'");
+inline const std::vector<EnumName<SyncPolicy>>& enumNames(SyncPolicy) {
+  static const std::vector<EnumName<SyncPolicy>> names{{SyncPolicy::kAuto, "auto"},
+                                                       {SyncPolicy::kExact, "exact"},
+                                                       {SyncPolicy::kApproximate, "approximate"},
+                                                       {SyncPolicy::kOrdered, "ordered"}};
+  return names;
 }
 
 inline std::string toString(SyncPolicy policy) {
-  return policy == SyncPolicy::kExact         ? "exact"
-         : policy == SyncPolicy::kApproximate ? "approximate"
-                                              : "ordered";
+  return settingText(policy);
 }
 
 // A synchronizer of `filters` with the exact or approximate policy, calling `object->*method`.

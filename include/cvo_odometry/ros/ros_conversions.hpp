@@ -4,6 +4,8 @@
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -11,7 +13,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "cvo_odometry/CvoIndicator.h"
 #include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/frontend/odometry_pipeline.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 
 namespace cvo {
@@ -32,9 +36,41 @@ cv::Mat labelImageFromMsg(const sensor_msgs::Image& msg);
 // The 32FC1 disparity (pixels) of stereo_image_proc's DisparityImage.
 cv::Mat disparityImageFromMsg(const stereo_msgs::DisparityImage& msg);
 
+// A pipeline frame from the synchronized messages (labels may be null; right and right_info are
+// null with a disparity image, disparity null without). Throws std::invalid_argument naming
+// what is wrong with a message.
+CameraFrame rgbdFrameFromMsgs(const sensor_msgs::Image& image, const sensor_msgs::CameraInfo& info,
+                              const sensor_msgs::Image& depth, const sensor_msgs::Image* labels);
+CameraFrame stereoFrameFromMsgs(const sensor_msgs::Image& left,
+                                const sensor_msgs::CameraInfo& left_info,
+                                const sensor_msgs::Image* right,
+                                const sensor_msgs::CameraInfo* right_info,
+                                const stereo_msgs::DisparityImage* disparity);
+
+// base <- camera optical frame for a camera looking along the base's x axis (REP-103: the
+// optical frame is z forward, x right, y down; the body frame x forward, y left, z up).
+Eigen::Isometry3d opticalFrameInBase();
+
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose);
+Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose);
 geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& pose);
 Eigen::Isometry3d fromTransformMsg(const geometry_msgs::Transform& transform);
+
+// The odometry of a processed frame: pose and covariance of the base in `odom_frame`, twist and
+// its covariance in `base_frame` (REP-105).
+nav_msgs::Odometry odometryMsg(const OdometryUpdate& update, const ros::Time& stamp,
+                               const std::string& odom_frame, const std::string& base_frame);
+// The TF odom_frame -> base_frame of the same.
+geometry_msgs::TransformStamped odometryTransformMsg(const nav_msgs::Odometry& odometry);
+
+// What the nodelet adds to a pipeline result for the indicator.
+struct IndicatorExtras {
+  double latency_ms = 0.0;
+  std::size_t dropped_frames = 0;
+};
+cvo_odometry::CvoIndicator indicatorMsg(const PipelineResult& result, const ros::Time& stamp,
+                                        const std::string& odom_frame,
+                                        const IndicatorExtras& extras);
 
 // x, y, z, rgb (packed float, as rviz reads it) and, with semantics, label (argmax class, uint16)
 // of every point moved by `transform`.

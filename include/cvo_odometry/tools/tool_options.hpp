@@ -7,28 +7,28 @@
 #include <string>
 #include <vector>
 
-#include "cvo_odometry/core/cvo_params.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
-#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
-#include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+#include "cvo_odometry/frontend/odometry_pipeline.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 
 namespace cvo {
 
-// Throws std::invalid_argument for a malformed override or parameters that make no sense.
-CvoParams cvoParamsFrom(const CommandLine& cli);
-RgbdFrontendOptions rgbdFrontendOptionsFrom(const CommandLine& cli);
-StereoFrontendOptions stereoFrontendOptionsFrom(const CommandLine& cli);
+// The settings in effect: the defaults with the dataset format's own (the TUM depth scale), then
+// the preset (--preset, or the dataset's: kitti_stereo for
+// --kitti), then --set k=v,..., then --NAME VALUE for single settings. Throws
+// std::invalid_argument / FormatError naming a bad option or value.
+OdometrySettings settingsFrom(const CommandLine& cli);
 
-// The option names the helpers above and openSequence() read.
+// The option names the helpers here read: the tools' own and one per setting.
 std::vector<std::string> sharedOptionNames();
-extern const char* const kSharedOptionsUsage;
+std::string sharedOptionsUsage();
 
 // A recorded sequence ready to run: frame stamps and a cloud builder per frame.
 struct SequenceInput {
   std::string kind;  // "tum" or "kitti"
   std::vector<double> stamps;
-  std::function<LabeledCloud(std::size_t index, FrontendStats* stats)> cloud;
+  std::function<CameraFrame(std::size_t index)> frame;  // decoded images of frame `index`
   TrajectoryFormat trajectory_format = TrajectoryFormat::kTum;
   std::string times_path;  // KITTI: times.txt, which stamps KITTI-format ground truth
 };
@@ -36,5 +36,8 @@ struct SequenceInput {
 // From --tum DIR (with --camera, --stamp depth|rgb) or --kitti DIR (with --kitti-camera 0|2);
 // --segmentation DIR and --semantic-classes N add a segmentation image per frame.
 SequenceInput openSequence(const CommandLine& cli);
+
+// The labeled cloud of one frame by the front end of `settings`.
+LabeledCloud buildCloud(const OdometrySettings& settings, const CameraFrame& frame);
 
 }  // namespace cvo

@@ -4,18 +4,22 @@
 #include <iosfwd>
 #include <map>
 
-#include "cvo_odometry/core/frame_to_frame_odometry.hpp"
+#include "cvo_odometry/frontend/odometry_pipeline.hpp"
 
 namespace cvo {
 
 class TrackingTally {
  public:
   void add(TrackingState state) { ++counts_[state]; }
-  // "tracking: T tracked, R recovered, L lost, S resets, F first frames" and a newline.
+  // A pipeline's frame: its state when processed, else counted as skipped or stale.
+  void add(const PipelineResult& result);
+  // "tracking: T tracked, R recovered, L lost, S resets, F first frames, K skipped, R stale"
+  // and a newline.
   void print(std::ostream& out) const;
 
  private:
   std::map<TrackingState, std::size_t> counts_;
+  std::size_t skipped_ = 0, stale_ = 0;
 };
 
 }  // namespace cvo

@@ -1,0 +1,169 @@
+// Keyframe odometry over CVO, the pipeline's core: each cloud is registered to the reference (the
+// keyframe, or the previous good frame), judged (tracking_check.hpp), and chained into a pose
+// with its covariance on SE(3) (pose_covariance.hpp) in the camera and the base frame.
+//
+// Guesses (CvoParams::initial_guess): the feature prior (keyframe <- current from tracked
+// corners, when confident), constant velocity (the last good motion rate from the previous
+// frame's pose), or none (the previous frame's pose, at the first-frame lengthscale). In auto,
+// a confident prior is used; when it and constant velocity disagree by more than a bound both
+// are tried and the better registration kept. A bad registration is retried from the guess not
+// yet tried (prior, then none); if that fails too the frame is lost and
+// CvoParams::lost_frame_policy says what its pose is. A registration is good only when it
+// converged, its cosine and speed are plausible and, with enough inlier tracks to judge, the
+// tracks agree with it.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/motion_prior.hpp"
+#include "cvo_odometry/core/photometric_rotation.hpp"
+
+namespace cvo {
+
+enum class TrackingState {
+  kFirstFrame,  // no reference yet: the frame becomes it, no registration
+  kTracking,    // registered and judged good
+  kRecovered,   // the first registration was bad, a retry good
+  kLost,        // no trusted registration: the pose is a guess
+  kReset        // lost, and tracking restarts from this frame, holding the last pose
+};
+
+std::string toString(TrackingState state);
+
+// Which guess a registration started from.
+enum class GuessKind { kNone, kConstantVelocity, kFeatures, kIdentity };
+std::string toString(GuessKind guess);
+
+// One frame for the odometry.
+struct OdometryFrame {
+  double stamp = 0.0;
+  std::shared_ptr<const LabeledCloud> cloud;  // null: the front end found nothing to track
+  std::string why_no_cloud;
+  std::optional<MotionPrior> prior;  // keyframe <- current from feature tracks
+  // base <- camera; taken at the first frame of a trajectory (after a reset).
+  Eigen::Isometry3d base_from_camera = Eigen::Isometry3d::Identity();
+};
+
+struct OdometryUpdate {
+  TrackingState state = TrackingState::kFirstFrame;
+  // False for a lost frame under LostFramePolicy::kPublishNothing: report no pose.
+  bool has_pose = true;
+  double stamp = 0.0;
+  double dt = 0.0;                                           // seconds since the reference frame
+  double frame_interval = 0.0;                               // seconds since the previous frame
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();    // start <- current (camera)
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // reference <- current (camera)
+  RegistrationReport report;                                 // of the registration used
+  PhotometricReport photometric;  // of the photometric stage (run on a good registration)
+  double cosine = 0.0;            // at the result and final lengthscale; 0 without a registration
+  int attempts = 0;               // registrations run for this frame
+  int lost_frames = 0;            // consecutive lost frames up to and including this one
+  std::string problem;            // why a registration was judged bad (also after a recovery)
+  std::size_t reference_points = 0;
+  bool new_keyframe = false;           // this frame is the reference from now on
+  GuessKind guess = GuessKind::kNone;  // of the registration used
+  double track_agreement = -1.0;       // of the registration used; -1: not judged
+  // In the base frame (REP-105: odom <- base_link), base = base_from_camera of the trajectory.
+  Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d base_frame_motion = Eigen::Isometry3d::Identity();  // previous <- current
+  Matrix6d pose_covariance = Matrix6d::Zero();   // about odom's axes, [x y z rx ry rz]
+  Matrix6d twist_covariance = Matrix6d::Zero();  // in the base frame, per s^2
+
+  bool firstFrame() const { return state == TrackingState::kFirstFrame; }
+  // The pose comes from a registration judged good (or is the start of a trajectory).
+  bool trusted() const {
+    return state == TrackingState::kTracking || state == TrackingState::kRecovered ||
+           (firstFrame() && problem.empty());
+  }
+  // Linear (m/s) and angular (rad/s) velocity in the base frame over the frame interval.
+  Vector6d baseTwist() const;
+};
+
+class KeyframeOdometry {
+ public:
+  explicit KeyframeOdometry(const CvoParams& params,
+                            std::unique_ptr<RegistrationBackend> backend = nullptr);
+
+  // Throws std::invalid_argument if the stamp is not after the previous frame's (reset() first
+  // for a new sequence), or for clouds the registration rejects (non-finite points, missing
+  // features). A missing cloud or one with too few points is a lost frame, not an error.
+  OdometryUpdate process(OdometryFrame frame);
+  OdometryUpdate process(double stamp, LabeledCloud cloud);
+  // A frame that produced no cloud (e.g. no valid depth): lost, for `why`.
+  OdometryUpdate processLostFrame(double stamp, const std::string& why);
+  // Forgets everything: the next frame starts a new trajectory with the base at `base_pose`.
+  void reset(const Eigen::Isometry3d& base_pose = Eigen::Isometry3d::Identity());
+
+  // New parameters from the next frame on (see CvoRegistration::setParams).
+  void setParams(const CvoParams& params);
+
+  CvoRegistration& registration() { return registration_; }
+  const CvoParams& params() const { return registration_.params(); }
+  bool hasReference() const { return reference_ != nullptr; }
+  // The cloud the next frame will be registered to, or null.
+  const std::shared_ptr<const LabeledCloud>& referenceCloud() const { return reference_; }
+  std::optional<double> lastStamp() const { return last_stamp_; }
+
+ private:
+  struct Attempt {
+    RegistrationResult result;
+    PhotometricReport photometric;
+    GuessKind guess = GuessKind::kNone;
+    double cosine = 0.0;
+    double agreement = -1.0;
+    std::string problems;
+    bool good = false;
+  };
+  struct Guess {
+    GuessKind kind;
+    Eigen::Isometry3d motion;  // reference <- current
+  };
+  Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
+                  double dt);
+  // The guesses to try, in order, and those kept for a retry.
+  void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
+                     std::vector<Guess>* retries) const;
+  bool priorConfident(const std::optional<MotionPrior>& prior) const;
+  // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
+  double referenceSelfProduct(double ell);
+  void checkStamp(double stamp) const;
+  // A frame without a reference: it becomes the reference (with enough points); the pose holds.
+  OdometryUpdate startFrom(const OdometryFrame& frame);
+  // reference <- current if the camera kept its velocity since the previous frame.
+  std::optional<Eigen::Isometry3d> constantVelocityMotion(double interval) const;
+  Eigen::Isometry3d stillMotion() const;  // reference <- previous frame
+  void accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame);
+  bool wantsKeyframe(const OdometryUpdate& update, const OdometryFrame& frame) const;
+  // `cloud` becomes the reference at the current pose; none when it is missing or has fewer
+  // than min_tracking_points.
+  void setReference(const std::shared_ptr<const LabeledCloud>& cloud, double stamp);
+  void lose(OdometryUpdate& update, const OdometryFrame& frame, const std::string& why);
+  // The base-frame pose, motion and covariances of `update` from the camera-frame chain.
+  void fillBaseFrame(OdometryUpdate& update, const Matrix6d& motion_covariance);
+
+  CvoRegistration registration_;
+  std::shared_ptr<const LabeledCloud> reference_;
+  // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
+  std::optional<std::pair<double, double>> reference_self_, source_self_;
+  double reference_stamp_ = 0.0;
+  Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();
+  Matrix6d reference_covariance_ = Matrix6d::Zero();
+  std::optional<double> last_stamp_;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();  // the latest estimate
+  Matrix6d covariance_ = Matrix6d::Zero();                  // of pose_ (body frame)
+  // The last good frame-to-frame motion rate (twist per second, [omega; v]).
+  std::optional<Vector6d> velocity_;
+  Eigen::Isometry3d last_trusted_pose_ = Eigen::Isometry3d::Identity();
+  std::optional<double> last_trusted_stamp_;
+  int lost_frames_ = 0;
+  bool started_ = false;
+  Eigen::Isometry3d base_from_camera_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d start_base_pose_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace cvo

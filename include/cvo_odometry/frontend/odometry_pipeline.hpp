@@ -1,0 +1,92 @@
+// The odometry pipeline without ROS, which the nodelet and the tools share (as kiss-icp's
+// pipeline sits between its core and its ROS node): a camera frame in (images, intrinsics,
+// stamp, base <- camera), the front end's labeled cloud, registration against the reference,
+// the tracking judgement, and the pose, twist and covariance in the base frame out. Every kind
+// of bad input is classified here, once, for everyone:
+//   - malformed input (empty or mismatched images, an unsupported encoding, intrinsics that make
+//     no sense, non-finite points): the frame is skipped, not counted as a frame;
+//   - a frame with a stamp equal to the previous one: skipped; an earlier stamp (a looping bag,
+//     a restarted driver): the odometry restarts from that frame, said in `why`;
+//   - an image byte-identical to its stream's previous one (a driver repeating frames): stale,
+//     skipped (`stale_burst_start` on the first of a run, to log once per burst);
+//   - a well-formed frame with nothing to track (no valid depth, too few points): a lost frame.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/keyframe_odometry.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
+#include "cvo_odometry/frontend/stale_frame_detector.hpp"
+
+namespace cvo {
+
+using CameraFrame = std::variant<RgbdFrame, StereoFrame>;
+
+enum class FrameOutcome {
+  kProcessed,  // the odometry took the frame (tracked, recovered, lost, first)
+  kSkipped,    // malformed input or a repeated stamp: not a frame
+  kStale       // an image repeats its stream's previous one
+};
+
+struct PipelineResult {
+  FrameOutcome outcome = FrameOutcome::kProcessed;
+  std::string why;                 // skipped or stale: why; processed: a note (time jump)
+  bool stale_burst_start = false;  // the first stale frame after a fresh one
+  OdometryUpdate update;           // processed frames
+  FrontendStats stats;
+  std::shared_ptr<const LabeledCloud> cloud;      // the frame's cloud, when it had one
+  std::shared_ptr<const LabeledCloud> reference;  // what it was registered to, if anything
+  std::optional<MotionPrior> prior;               // the feature prior, when it ran
+  double total_ms = 0.0;
+};
+
+class OdometryPipeline {
+ public:
+  // Makes the registration backend for the CVO parameters (default: makeBackend, with the
+  // fallback note in backendNote()). Throws when the backend cannot be made.
+  using BackendFactory = std::function<std::unique_ptr<RegistrationBackend>(const CvoParams&)>;
+
+  // Throws std::invalid_argument for settings that make no sense.
+  explicit OdometryPipeline(const OdometrySettings& settings, BackendFactory factory = {});
+
+  PipelineResult process(double stamp, const CameraFrame& frame,
+                         const Eigen::Isometry3d& base_from_camera = Eigen::Isometry3d::Identity());
+  // The next frame starts a new trajectory with the base at `base_pose`.
+  void reset(const Eigen::Isometry3d& base_pose = Eigen::Isometry3d::Identity());
+
+  // New settings from the next frame on: all or nothing, the old ones stay when the new ones
+  // are refused (std::invalid_argument) or their backend cannot be made (std::runtime_error). A
+  // new backend restarts the odometry (returns true then).
+  bool setSettings(const OdometrySettings& settings);
+  const OdometrySettings& settings() const { return settings_; }
+
+  std::string backendName() { return odometry_->registration().backend().name(); }
+  // Why `backend: auto` settled on the CPU, else empty.
+  const std::string& backendNote() const { return backend_note_; }
+  KeyframeOdometry& odometry() { return *odometry_; }
+
+ private:
+  std::unique_ptr<KeyframeOdometry> makeOdometry(const OdometrySettings& settings);
+  // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
+  // throws std::invalid_argument.
+  std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats);
+  std::string staleness(const CameraFrame& frame);
+
+  OdometrySettings settings_;
+  BackendFactory factory_;
+  std::string backend_note_;
+  std::unique_ptr<KeyframeOdometry> odometry_;
+  std::unique_ptr<RgbdCloudBuilder> rgbd_builder_;
+  std::unique_ptr<StereoCloudBuilder> stereo_builder_;
+  StaleFrameDetector stale_;
+  bool stale_burst_ = false;
+  Eigen::Isometry3d start_pose_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace cvo

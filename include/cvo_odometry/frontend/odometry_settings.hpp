@@ -1,0 +1,71 @@
+// Every setting of the odometry below ROS: the core's (cvo_settings.hpp) and the front end's
+// rows of the settings table, one aggregate that presets, the tools and the nodelet read.
+#pragma once
+
+#include <string>
+
+#include "cvo_odometry/core/cvo_settings.hpp"
+#include "cvo_odometry/frontend/depth_cloud_builder.hpp"
+#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
+#include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
+#include "cvo_odometry/frontend/stereo_matcher.hpp"
+
+namespace cvo {
+
+struct OdometrySettings {
+  CvoParams cvo;
+  CloudBuilderOptions cloud;
+  StereoMatcherOptions stereo;
+  double depth_scale = 1000.0;  // 16-bit depth units per metre
+
+  // Throws std::invalid_argument naming the first setting that makes no sense.
+  void validate() const;
+
+  // The front ends' options. The grey image levels only while the photometric stage, their
+  // one user, is on (they cost a few ms a frame).
+  CloudBuilderOptions cloudOptions() const;
+  RgbdFrontendOptions rgbdOptions() const;
+  StereoFrontendOptions stereoOptions() const;
+};
+
+template <class V>
+void visitSettings(OdometrySettings& s, V&& v) {
+  visitSettings(s.cvo, v);
+  v(SettingInfo{"point_selector", "points",
+                "which pixels become points: grid (uniform), fast (FAST corners) or mixed"},
+    s.cloud.selector.kind);
+  v(SettingInfo{"min_points", "points", "fewest selected points per frame", 100, 200000},
+    s.cloud.selector.min_points);
+  v(SettingInfo{"max_points", "points", "most selected points per frame", 100, 400000},
+    s.cloud.selector.max_points);
+  v(SettingInfo{"min_depth", "depth", "nearer points are not used (m)", 0.0, 1000.0},
+    s.cloud.min_depth);
+  v(SettingInfo{"max_depth", "depth", "farther points are not used (m)", 0.01, 10000.0},
+    s.cloud.max_depth);
+  v(SettingInfo{"depth_scale", "depth", "16-bit depth units per metre (1000: ROS millimetres)",
+                1e-3, 1e6},
+    s.depth_scale);
+  v(SettingInfo{"crop_top_rows", "points", "rows at the top never used (KITTI: sky)", 0, 100000},
+    s.cloud.crop_top_rows);
+  v(SettingInfo{"image_levels", "photometric",
+                "blur levels of the grey image for the photometric stage (sigmas ..., 1, 0 px)", 0,
+                6},
+    s.cloud.image_levels);
+  v(SettingInfo{"semantic_classes", "semantics",
+                "classes of the segmentation images (0: no segmentation)", 0, 65536},
+    s.cloud.semantic_classes);
+  v(SettingInfo{"ignore_classes", "semantics", "class ids whose pixels are never used", 0, 65535},
+    s.cloud.ignore_classes);
+  v(SettingInfo{"num_disparities", "stereo", "SGBM disparity range (a multiple of 16)", 16, 1024},
+    s.stereo.num_disparities);
+  v(SettingInfo{"block_size", "stereo", "SGBM block size (odd)", 1, 21}, s.stereo.block_size);
+  v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
+    s.stereo.mode);
+}
+
+// Defaults, then the preset at `path` (empty: none), validated; FormatError names the file and
+// line of a bad key or value.
+OdometrySettings loadOdometrySettings(const std::string& path,
+                                      const OdometrySettings& base = OdometrySettings());
+
+}  // namespace cvo

@@ -1,0 +1,407 @@
+#include "cvo_odometry/core/keyframe_odometry.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/pose_covariance.hpp"
+#include "cvo_odometry/core/registration_covariance.hpp"
+#include "cvo_odometry/core/tracking_check.hpp"
+
+namespace cvo {
+
+namespace {
+
+// A twist covariance nobody knows (the first frame): large, as REP-105 consumers expect.
+constexpr double kUnknownVariance = 1e6;
+
+double angleDeg(const Eigen::Isometry3d& T) {
+  return lie::rotationAngle(T.rotation()) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+std::string toString(TrackingState state) {
+  switch (state) {
+    case TrackingState::kFirstFrame:
+      return "first_frame";
+    case TrackingState::kTracking:
+      return "tracking";
+    case TrackingState::kRecovered:
+      return "recovered";
+    case TrackingState::kLost:
+      return "lost";
+    default:
+      return "reset";
+  }
+}
+
+std::string toString(GuessKind guess) {
+  switch (guess) {
+    case GuessKind::kConstantVelocity:
+      return "constant_velocity";
+    case GuessKind::kFeatures:
+      return "features";
+    case GuessKind::kIdentity:
+      return "identity";
+    default:
+      return "none";
+  }
+}
+
+Vector6d OdometryUpdate::baseTwist() const {
+  Vector6d twist = Vector6d::Zero();
+  if (!(frame_interval > 0.0) || firstFrame()) return twist;
+  twist.head<3>() = base_frame_motion.translation() / frame_interval;
+  twist.tail<3>() = lie::logSO3(base_frame_motion.rotation()) / frame_interval;
+  return twist;
+}
+
+KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
+                                   std::unique_ptr<RegistrationBackend> backend)
+    : registration_(params, std::move(backend)) {}
+
+void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
+  reference_.reset();
+  reference_self_.reset();
+  last_stamp_.reset();
+  velocity_.reset();
+  last_trusted_stamp_.reset();
+  pose_.setIdentity();
+  reference_pose_.setIdentity();
+  covariance_.setZero();
+  reference_covariance_.setZero();
+  lost_frames_ = 0;
+  started_ = false;
+  start_base_pose_ = base_pose;
+}
+
+void KeyframeOdometry::setParams(const CvoParams& params) {
+  registration_.setParams(params);
+  reference_self_.reset();  // the kernels may have changed
+}
+
+void KeyframeOdometry::checkStamp(double stamp) const {
+  if (last_stamp_ && !(stamp > *last_stamp_)) {
+    throw std::invalid_argument("frame time " + std::to_string(stamp) +
+                                " is not after the previous frame's " +
+                                std::to_string(*last_stamp_) + "; reset the odometry first");
+  }
+}
+
+std::optional<Eigen::Isometry3d> KeyframeOdometry::constantVelocityMotion(double interval) const {
+  if (!velocity_) return std::nullopt;
+  return lie::orthonormalized(reference_pose_.inverse() * pose_ *
+                              lie::expSE3(*velocity_ * interval));
+}
+
+Eigen::Isometry3d KeyframeOdometry::stillMotion() const {
+  return lie::orthonormalized(reference_pose_.inverse() * pose_);
+}
+
+bool KeyframeOdometry::priorConfident(const std::optional<MotionPrior>& prior) const {
+  return prior && prior->solved && prior->inliers >= params().min_prior_inliers &&
+         prior->inlier_ratio >= params().min_prior_inlier_ratio;
+}
+
+void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval,
+                                     std::vector<Guess>* first, std::vector<Guess>* retries) const {
+  const CvoParams& p = params();
+  const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(interval);
+  const Guess still{GuessKind::kIdentity, stillMotion()};
+  const bool confident = priorConfident(frame.prior);
+  const Guess prior{GuessKind::kFeatures,
+                    confident ? frame.prior->motion : Eigen::Isometry3d::Identity()};
+  const Guess constant{GuessKind::kConstantVelocity,
+                       velocity ? *velocity : Eigen::Isometry3d::Identity()};
+  switch (p.initial_guess) {
+    case InitialGuess::kIdentity:
+      first->push_back(still);
+      return;
+    case InitialGuess::kConstantVelocity:
+      first->push_back(velocity ? constant : still);
+      if (velocity) retries->push_back(still);
+      return;
+    case InitialGuess::kFeatures:
+      first->push_back(confident ? prior : velocity ? constant : still);
+      if (first->front().kind != GuessKind::kIdentity) retries->push_back(still);
+      return;
+    case InitialGuess::kAuto:
+      if (confident) {
+        first->push_back(prior);
+        if (velocity) {
+          const Eigen::Isometry3d apart = prior.motion.inverse() * constant.motion;
+          if (apart.translation().norm() > p.guess_disagreement_translation ||
+              angleDeg(apart) > p.guess_disagreement_rotation) {
+            first->push_back(constant);
+          }
+        }
+        retries->push_back(still);
+      } else {
+        first->push_back(velocity ? constant : still);
+        if (velocity) retries->push_back(still);
+      }
+      return;
+  }
+}
+
+KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, const Guess& guess,
+                                                    const OdometryFrame& frame, double dt) {
+  const CvoParams& p = params();
+  Attempt a;
+  a.guess = guess.kind;
+  // Without a motion guess the registration needs the wide first-frame lengthscale.
+  a.result =
+      registration_.align(*reference_, cloud, guess.motion, guess.kind == GuessKind::kIdentity);
+  const RegistrationReport& report = a.result.report;
+  // cos = F_XZ / sqrt(F_XX F_ZZ). F_XZ comes with the report (the indicator times
+  // sqrt(|X||Z|)); F_XX is cached per reference. No pairs in reach: nothing to take.
+  const double ell = report.final_lengthscale;
+  if (ell > 0.0) {
+    const double cross =
+        report.indicator_after * std::sqrt(static_cast<double>(reference_->size()) * cloud.size());
+    if (!source_self_ || source_self_->first != ell) {
+      source_self_.emplace(ell, registration_.selfProduct(cloud, ell));
+    }
+    a.cosine = cross / std::sqrt(referenceSelfProduct(ell) * source_self_->second);
+  }
+  const TrackingCheck check = checkRegistration(report, a.cosine, a.result.transform, dt, p);
+  a.good = check.good;
+  a.problems = check.problems;
+  if (!a.good) return a;
+  // Only a registration judged good is refined: a bad one is retried or lost anyway.
+  if (p.photometric_rotation) {
+    if (reference_->image() && cloud.image()) {
+      PhotometricRotationResult refined = refineRotationPhotometrically(
+          *reference_->image(), *cloud.image(), cloud, a.result.transform, p);
+      a.result.transform = refined.transform;
+      a.photometric = refined.report;
+    } else {
+      a.photometric.skipped = "the clouds carry no image";
+    }
+  }
+  // The feature tracks, independent of CVO, catch a registration stuck near a wrong guess.
+  if (priorConfident(frame.prior)) {
+    a.agreement = trackAgreement(*frame.prior, a.result.transform, p.track_agreement_px);
+    if (a.agreement < p.min_track_agreement) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "feature tracks disagree: " << 100.0 * a.agreement << " % of "
+          << frame.prior->points.size() << " inlier tracks within " << p.track_agreement_px
+          << " px < min_track_agreement " << p.min_track_agreement;
+      a.good = false;
+      a.problems = why.str();
+    }
+  }
+  return a;
+}
+
+double KeyframeOdometry::referenceSelfProduct(double ell) {
+  if (!reference_self_ || reference_self_->first != ell) {
+    reference_self_.emplace(ell, registration_.selfProduct(*reference_, ell));
+  }
+  return reference_self_->second;
+}
+
+OdometryUpdate KeyframeOdometry::process(double stamp, LabeledCloud cloud) {
+  OdometryFrame frame;
+  frame.stamp = stamp;
+  frame.cloud = std::make_shared<const LabeledCloud>(std::move(cloud));
+  return process(std::move(frame));
+}
+
+OdometryUpdate KeyframeOdometry::processLostFrame(double stamp, const std::string& why) {
+  OdometryFrame frame;
+  frame.stamp = stamp;
+  frame.why_no_cloud = why;
+  return process(std::move(frame));
+}
+
+OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
+  checkStamp(frame.stamp);
+  source_self_.reset();
+  if (!started_) {
+    base_from_camera_ = frame.base_from_camera;
+    started_ = true;
+  }
+  if (params().forget_motion) velocity_.reset();
+  if (!reference_) return startFrom(frame);
+  const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
+  OdometryUpdate update;
+  update.stamp = frame.stamp;
+  update.dt = frame.stamp - reference_stamp_;
+  update.frame_interval = frame.stamp - *last_stamp_;
+  update.reference_points = reference_->size();
+  if (!cloud) {
+    lose(update, frame, frame.why_no_cloud);
+    return update;
+  }
+  const TrackingCheck counts = checkPointCounts(reference_->size(), cloud->size(), params());
+  if (!counts.good) {
+    lose(update, frame, counts.problems);
+    return update;
+  }
+  std::vector<Guess> first, retries;
+  chooseGuesses(frame, update.frame_interval, &first, &retries);
+  std::optional<Attempt> chosen;
+  std::string problems;
+  const auto better = [](const Attempt& a, const Attempt& b) {
+    if (a.agreement >= 0.0 && b.agreement >= 0.0 && a.agreement != b.agreement) {
+      return a.agreement > b.agreement;
+    }
+    return a.cosine > b.cosine;
+  };
+  const auto tryGuess = [&](const Guess& guess) {
+    Attempt a = attempt(*cloud, guess, frame, update.dt);
+    ++update.attempts;
+    if (!a.good) {
+      problems += (problems.empty() ? "" : "; retry: ") + a.problems;
+      if (!chosen) chosen = std::move(a);  // reported when nothing is good
+    } else if (!chosen || !chosen->good || better(a, *chosen)) {
+      chosen = std::move(a);
+    }
+  };
+  for (const Guess& guess : first)
+    tryGuess(guess);
+  for (const Guess& guess : retries) {
+    if (chosen->good) break;
+    tryGuess(guess);
+    if (chosen->good) update.state = TrackingState::kRecovered;
+  }
+  update.problem = chosen->good && update.state != TrackingState::kRecovered ? "" : problems;
+  update.report = chosen->result.report;
+  update.photometric = chosen->photometric;
+  update.cosine = chosen->cosine;
+  update.guess = chosen->guess;
+  update.track_agreement = chosen->agreement;
+  if (!chosen->good) {
+    lose(update, frame, problems);
+    return update;
+  }
+  if (update.state != TrackingState::kRecovered) update.state = TrackingState::kTracking;
+  accept(update, *chosen, frame);
+  return update;
+}
+
+OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
+  const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
+  OdometryUpdate update;
+  update.stamp = frame.stamp;
+  update.state = TrackingState::kFirstFrame;
+  update.pose = pose_;
+  update.problem = frame.why_no_cloud;
+  update.frame_interval = last_stamp_ ? frame.stamp - *last_stamp_ : 0.0;
+  const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
+  if (cloud && cloud->size() < minimum) {
+    // Not worth tracking against: wait for a better first frame, holding the pose.
+    update.problem = "too few points for a first frame (" + std::to_string(cloud->size()) + ")";
+  }
+  update.new_keyframe = cloud && cloud->size() >= minimum;
+  setReference(cloud, frame.stamp);
+  last_trusted_pose_ = pose_;  // the start of the velocity estimate
+  last_trusted_stamp_ = frame.stamp;
+  fillBaseFrame(update, Matrix6d::Identity() * kUnknownVariance);
+  update.twist_covariance = Matrix6d::Identity() * kUnknownVariance;
+  last_stamp_ = frame.stamp;
+  return update;
+}
+
+void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& cloud,
+                                    double stamp) {
+  reference_.reset();
+  reference_self_.reset();
+  if (cloud && cloud->size() >= static_cast<std::size_t>(params().min_tracking_points)) {
+    reference_ = cloud;
+    reference_self_ = source_self_;  // F(Z, Z) of this cloud, if its registration computed it
+  }
+  reference_stamp_ = stamp;
+  reference_pose_ = pose_;
+  reference_covariance_ = covariance_;
+}
+
+bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update,
+                                     const OdometryFrame& frame) const {
+  const CvoParams& p = params();
+  return p.reference == ReferenceKind::kPreviousFrame ||
+         update.state == TrackingState::kRecovered || update.cosine < p.keyframe_min_cosine ||
+         update.motion.translation().norm() > p.keyframe_max_translation ||
+         angleDeg(update.motion) > p.keyframe_max_rotation ||
+         (frame.prior && frame.prior->wants_keyframe);
+}
+
+void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame) {
+  update.motion = chosen.result.transform;
+  const Matrix6d motion_covariance = rightPerturbation(
+      update.motion, registrationCovariance(*frame.cloud, update.motion,
+                                            update.report.final_lengthscale, update.cosine));
+  const Eigen::Isometry3d previous = pose_;
+  pose_ = lie::orthonormalized(reference_pose_ * update.motion);
+  covariance_ = propagateCovariance(reference_covariance_, update.motion, motion_covariance);
+  update.pose = pose_;
+  if (last_trusted_stamp_ && update.stamp > *last_trusted_stamp_) {
+    velocity_ =
+        lie::logSE3(last_trusted_pose_.inverse() * pose_) / (update.stamp - *last_trusted_stamp_);
+  }
+  last_trusted_pose_ = pose_;
+  last_trusted_stamp_ = update.stamp;
+  lost_frames_ = 0;
+  update.new_keyframe = wantsKeyframe(update, frame);
+  if (update.new_keyframe) setReference(frame.cloud, update.stamp);
+  fillBaseFrame(update, motion_covariance);
+  update.base_frame_motion =
+      base_from_camera_ * previous.inverse() * pose_ * base_from_camera_.inverse();
+  last_stamp_ = update.stamp;
+}
+
+void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
+                            const std::string& why) {
+  const CvoParams& p = params();
+  update.problem = why;
+  update.lost_frames = ++lost_frames_;
+  // The best guess there is: the feature prior when confident, else constant velocity.
+  const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(update.frame_interval);
+  update.motion = priorConfident(frame.prior) ? frame.prior->motion
+                  : velocity                  ? *velocity
+                                              : stillMotion();
+  const Matrix6d guessed = guessedMotionCovariance(p, update.frame_interval);
+  const Eigen::Isometry3d previous = pose_;
+  const bool restart =
+      p.lost_frame_policy == LostFramePolicy::kReset || lost_frames_ > p.max_lost_frames;
+  if (!restart) pose_ = lie::orthonormalized(reference_pose_ * update.motion);
+  covariance_ = propagateCovariance(covariance_, previous.inverse() * pose_, guessed);
+  update.pose = pose_;
+  fillBaseFrame(update, guessed);
+  update.base_frame_motion =
+      base_from_camera_ * previous.inverse() * pose_ * base_from_camera_.inverse();
+  last_stamp_ = update.stamp;
+  if (restart) {
+    // Restart from this frame. The pose holds (odom must stay continuous) and the velocity is
+    // forgotten; a frame with too few points leaves no reference, so the next one starts anew.
+    update.state = TrackingState::kReset;
+    update.has_pose = p.lost_frame_policy != LostFramePolicy::kPublishNothing;
+    setReference(frame.cloud, update.stamp);
+    update.new_keyframe = reference_ != nullptr;
+    velocity_.reset();
+    last_trusted_pose_ = pose_;
+    last_trusted_stamp_ = update.stamp;
+    lost_frames_ = 0;
+    return;
+  }
+  // Keep the reference: the next frame is registered to the last good one.
+  update.state = TrackingState::kLost;
+  update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
+}
+
+void KeyframeOdometry::fillBaseFrame(OdometryUpdate& update, const Matrix6d& motion_covariance) {
+  const Eigen::Isometry3d& B = base_from_camera_;
+  update.base_pose = lie::orthonormalized(start_base_pose_ * B * update.pose * B.inverse());
+  update.pose_covariance = toParentAxes(update.base_pose, conjugatedCovariance(B, covariance_));
+  const double interval = update.frame_interval;
+  update.twist_covariance =
+      interval > 0.0 ? Matrix6d(conjugatedCovariance(B, motion_covariance) / (interval * interval))
+                     : Matrix6d(Matrix6d::Identity() * kUnknownVariance);
+}
+
+}  // namespace cvo

@@ -1,0 +1,142 @@
+#include "cvo_odometry/frontend/odometry_pipeline.hpp"
+
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+#include "cvo_odometry/core/backend_factory.hpp"
+#include "cvo_odometry/frontend/empty_frame_error.hpp"
+
+namespace cvo {
+
+namespace {
+
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+std::string stampText(double stamp) {
+  std::ostringstream out;
+  out.precision(6);
+  out << std::fixed << stamp;
+  return out.str();
+}
+
+}  // namespace
+
+OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFactory factory)
+    : settings_(settings), factory_(std::move(factory)) {
+  settings_.validate();
+  odometry_ = makeOdometry(settings_);
+  rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(settings_.rgbdOptions());
+  stereo_builder_ = std::make_unique<StereoCloudBuilder>(settings_.stereoOptions());
+}
+
+std::unique_ptr<KeyframeOdometry> OdometryPipeline::makeOdometry(const OdometrySettings& settings) {
+  std::string note;
+  std::unique_ptr<RegistrationBackend> backend =
+      factory_ ? factory_(settings.cvo)
+               : makeBackend(settings.cvo.backend, settings.cvo.num_threads, &note);
+  auto odometry = std::make_unique<KeyframeOdometry>(settings.cvo, std::move(backend));
+  backend_note_ = note;
+  return odometry;
+}
+
+bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
+  settings.validate();
+  // Build everything new first: a refusal leaves the pipeline as it was.
+  auto rgbd = std::make_unique<RgbdCloudBuilder>(settings.rgbdOptions());
+  auto stereo = std::make_unique<StereoCloudBuilder>(settings.stereoOptions());
+  const bool new_backend = settings.cvo.backend != settings_.cvo.backend ||
+                           settings.cvo.num_threads != settings_.cvo.num_threads;
+  std::unique_ptr<KeyframeOdometry> odometry;
+  if (new_backend) odometry = makeOdometry(settings);
+  settings_ = settings;
+  rgbd_builder_ = std::move(rgbd);
+  stereo_builder_ = std::move(stereo);
+  if (new_backend) {
+    odometry_ = std::move(odometry);
+    reset(start_pose_);
+  } else {
+    odometry_->setParams(settings.cvo);
+  }
+  return new_backend;
+}
+
+void OdometryPipeline::reset(const Eigen::Isometry3d& base_pose) {
+  start_pose_ = base_pose;
+  odometry_->reset(base_pose);
+  stale_.reset();
+  stale_burst_ = false;
+}
+
+std::string OdometryPipeline::staleness(const CameraFrame& frame) {
+  if (const auto* rgbd = std::get_if<RgbdFrame>(&frame)) {
+    return stale_.check({rgbd->image, rgbd->depth}, {"colour", "depth"});
+  }
+  const auto& stereo = std::get<StereoFrame>(frame);
+  return stale_.check({stereo.left, stereo.right, stereo.disparity},
+                      {"left", "right", "disparity"});
+}
+
+std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,
+                                                                 FrontendStats* stats) {
+  if (const auto* rgbd = std::get_if<RgbdFrame>(&frame)) {
+    return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats));
+  }
+  return std::make_shared<const LabeledCloud>(
+      stereo_builder_->build(std::get<StereoFrame>(frame), stats));
+}
+
+PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
+                                         const Eigen::Isometry3d& base_from_camera) {
+  const auto start = std::chrono::steady_clock::now();
+  PipelineResult result;
+  const std::optional<double> last = odometry_->lastStamp();
+  if (last && stamp == *last) {
+    result.outcome = FrameOutcome::kSkipped;
+    result.why = "a second frame with stamp " + stampText(stamp);
+    return result;
+  }
+  if (last && stamp < *last) {
+    result.why = "time went backwards (" + stampText(stamp) + " after " + stampText(*last) +
+                 " s): a looping bag? odometry restarted";
+    reset(start_pose_);
+  }
+  const std::string stale = staleness(frame);
+  if (!stale.empty()) {
+    result.outcome = FrameOutcome::kStale;
+    result.why = stale;
+    result.stale_burst_start = !stale_burst_;
+    stale_burst_ = true;
+    return result;
+  }
+  stale_burst_ = false;
+  OdometryFrame input;
+  input.stamp = stamp;
+  input.base_from_camera = base_from_camera;
+  try {
+    input.cloud = buildCloud(frame, &result.stats);
+  } catch (const EmptyFrameError& e) {
+    input.why_no_cloud = e.what();  // well-formed, nothing to track: a lost frame
+  } catch (const std::invalid_argument& e) {
+    result.outcome = FrameOutcome::kSkipped;  // malformed: not a frame at all
+    result.why = e.what();
+    return result;
+  }
+  stale_.accept();
+  result.cloud = input.cloud;
+  result.reference = odometry_->referenceCloud();
+  try {
+    result.update = odometry_->process(std::move(input));
+  } catch (const std::invalid_argument& e) {
+    result.outcome = FrameOutcome::kSkipped;
+    result.why = std::string("registration rejected the frame: ") + e.what();
+    return result;
+  }
+  result.total_ms = millisecondsSince(start);
+  return result;
+}
+
+}  // namespace cvo

@@ -1,0 +1,42 @@
+#include "cvo_odometry/frontend/odometry_settings.hpp"
+
+namespace cvo {
+
+void OdometrySettings::validate() const {
+  cvo.validate();
+  cloud.validate();
+  stereo.validate();
+  if (!(depth_scale > 0.0)) throw std::invalid_argument("depth_scale must be positive");
+}
+
+CloudBuilderOptions OdometrySettings::cloudOptions() const {
+  CloudBuilderOptions options = cloud;
+  if (!cvo.photometric_rotation) options.image_levels = 0;
+  return options;
+}
+
+RgbdFrontendOptions OdometrySettings::rgbdOptions() const {
+  RgbdFrontendOptions options;
+  options.depth_units_per_metre = depth_scale;
+  options.cloud = cloudOptions();
+  return options;
+}
+
+StereoFrontendOptions OdometrySettings::stereoOptions() const {
+  StereoFrontendOptions options;
+  options.matcher = stereo;
+  options.cloud = cloudOptions();
+  return options;
+}
+
+OdometrySettings loadOdometrySettings(const std::string& path, const OdometrySettings& base) {
+  OdometrySettings settings = base;
+  if (path.empty()) {
+    settings.validate();
+  } else {
+    loadSettings(path, &settings);
+  }
+  return settings;
+}
+
+}  // namespace cvo
