@@ -70,8 +70,8 @@ void CvoParams::validate() const {
   requirePositive(max_angular_speed, "max_angular_speed");
   require(max_lost_frames >= 0, "max_lost_frames must be >= 0");
   require(photometric_iterations >= 1, "photometric_iterations must be >= 1");
-  require(keyframe_min_cosine >= 0.0 && keyframe_min_cosine < 1.0,
-          "keyframe_min_cosine must be in [0, 1)");
+  require(keyframe_cosine_ratio >= 0.0 && keyframe_cosine_ratio < 1.0,
+          "keyframe_cosine_ratio must be in [0, 1)");
   requirePositive(keyframe_max_translation, "keyframe_max_translation");
   requirePositive(keyframe_max_rotation, "keyframe_max_rotation");
   require(min_prior_inliers >= 4, "min_prior_inliers must be >= 4");

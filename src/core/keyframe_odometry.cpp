@@ -65,6 +65,8 @@ KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
 
 void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   reference_.reset();
+  last_good_.reset();
+  reference_first_cosine_.reset();
   reference_self_.reset();
   last_stamp_.reset();
   velocity_.reset();
@@ -173,10 +175,17 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   if (!a.good) return a;
   // Only a registration judged good is refined: a bad one is retried or lost anyway.
   if (p.photometric_rotation) {
-    if (reference_->image() && cloud.image()) {
+    // The rotation is refined against the last good frame's image, the nearest view: its error
+    // frame to frame stays that of one image pair, while the keyframe keeps the translation.
+    const bool nearer = last_good_ && last_good_->stamp != reference_stamp_ &&
+                        last_good_->cloud->image() != nullptr;
+    const LabeledCloud& view = nearer ? *last_good_->cloud : *reference_;
+    const Eigen::Isometry3d view_from_reference =
+        nearer ? last_good_->pose.inverse() * reference_pose_ : Eigen::Isometry3d::Identity();
+    if (view.image() && cloud.image()) {
       PhotometricRotationResult refined = refineRotationPhotometrically(
-          *reference_->image(), *cloud.image(), cloud, a.result.transform, p);
-      a.result.transform = refined.transform;
+          *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p);
+      a.result.transform = view_from_reference.inverse() * refined.transform;
       a.photometric = refined.report;
     } else {
       a.photometric.skipped = "the clouds carry no image";
@@ -270,6 +279,26 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
     tryGuess(guess);
     if (chosen->good) update.state = TrackingState::kRecovered;
   }
+  if (!chosen->good && last_good_ && last_good_->stamp != reference_stamp_) {
+    // The keyframe is out of reach: register to the last good frame instead, which is nearer
+    // (this frame then becomes the keyframe). The prior's tracks belong to the keyframe: they
+    // neither guess nor judge here.
+    setReference(*last_good_);
+    update.dt = frame.stamp - reference_stamp_;
+    update.reference_points = reference_->size();
+    OdometryFrame nearer = frame;
+    nearer.prior.reset();
+    first.clear(), retries.clear();
+    chooseGuesses(nearer, update.frame_interval, &first, &retries);
+    first.insert(first.end(), retries.begin(), retries.end());
+    for (const Guess& guess : first) {
+      if (chosen->good) break;
+      Attempt a = attempt(*cloud, guess, nearer, update.dt);
+      ++update.attempts;
+      problems += "; to the last good frame: " + a.problems;
+      if (a.good) chosen = std::move(a), update.state = TrackingState::kRecovered;
+    }
+  }
   update.problem = chosen->good && update.state != TrackingState::kRecovered ? "" : problems;
   update.report = chosen->result.report;
   update.photometric = chosen->photometric;
@@ -302,16 +331,24 @@ OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   setReference(cloud, frame.stamp);
   last_trusted_pose_ = pose_;  // the start of the velocity estimate
   last_trusted_stamp_ = frame.stamp;
+  if (reference_) last_good_ = GoodFrame{reference_, frame.stamp, pose_, covariance_};
   fillBaseFrame(update, Matrix6d::Identity() * kUnknownVariance);
   update.twist_covariance = Matrix6d::Identity() * kUnknownVariance;
   last_stamp_ = frame.stamp;
   return update;
 }
 
+void KeyframeOdometry::setReference(const GoodFrame& frame) {
+  setReference(frame.cloud, frame.stamp);
+  reference_pose_ = frame.pose;
+  reference_covariance_ = frame.covariance;
+}
+
 void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& cloud,
                                     double stamp) {
   reference_.reset();
   reference_self_.reset();
+  reference_first_cosine_.reset();
   if (cloud && cloud->size() >= static_cast<std::size_t>(params().min_tracking_points)) {
     reference_ = cloud;
     reference_self_ = source_self_;  // F(Z, Z) of this cloud, if its registration computed it
@@ -325,7 +362,9 @@ bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update,
                                      const OdometryFrame& frame) const {
   const CvoParams& p = params();
   return p.reference == ReferenceKind::kPreviousFrame ||
-         update.state == TrackingState::kRecovered || update.cosine < p.keyframe_min_cosine ||
+         update.state == TrackingState::kRecovered ||
+         (reference_first_cosine_ &&
+          update.cosine < p.keyframe_cosine_ratio * *reference_first_cosine_) ||
          update.motion.translation().norm() > p.keyframe_max_translation ||
          angleDeg(update.motion) > p.keyframe_max_rotation ||
          (frame.prior && frame.prior->wants_keyframe);
@@ -347,6 +386,8 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   last_trusted_pose_ = pose_;
   last_trusted_stamp_ = update.stamp;
   lost_frames_ = 0;
+  if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;
+  last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_};
   update.new_keyframe = wantsKeyframe(update, frame);
   if (update.new_keyframe) setReference(frame.cloud, update.stamp);
   fillBaseFrame(update, motion_covariance);

@@ -101,10 +101,12 @@ struct CvoParams {
   LostFramePolicy lost_frame_policy = LostFramePolicy::kKeepGuess;
   int max_lost_frames = 5;
 
-  // Keyframes: a new one when the cosine to it falls below keyframe_min_cosine, or the camera
-  // has moved or turned beyond the bounds since it (README "Keyframes").
-  ReferenceKind reference = ReferenceKind::kPreviousFrame;
-  double keyframe_min_cosine = 0.8;
+  // Keyframes: a new one when the cosine to it falls below keyframe_cosine_ratio times the
+  // cosine of the first frame registered to it (so the rule holds for stereo clouds, whose
+  // cosines are low, and RGB-D ones alike), or the camera has moved or turned beyond the bounds
+  // since it (README "Keyframes").
+  ReferenceKind reference = ReferenceKind::kKeyframe;
+  double keyframe_cosine_ratio = 0.7;
   double keyframe_max_translation = 0.1;  // m
   double keyframe_max_rotation = 5.0;     // deg
 

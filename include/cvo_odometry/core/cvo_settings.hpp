@@ -113,9 +113,11 @@ void visitSettings(CvoParams& p, V&& v) {
   v(SettingInfo{"reference", "odometry",
                 "register each frame to the keyframe or to the previous good frame"},
     p.reference);
-  v(SettingInfo{"keyframe_min_cosine", "odometry",
-                "a new keyframe when the cosine to the current one falls below this", 0.0, 0.99},
-    p.keyframe_min_cosine);
+  v(SettingInfo{"keyframe_cosine_ratio", "odometry",
+                "a new keyframe when the cosine falls below this fraction of the first one "
+                "registered to the keyframe",
+                0.0, 0.99},
+    p.keyframe_cosine_ratio);
   v(SettingInfo{"keyframe_max_translation", "odometry",
                 "a new keyframe when the camera has moved farther from it (m)", 0.001, 100.0},
     p.keyframe_max_translation);

@@ -123,6 +123,13 @@ class KeyframeOdometry {
     GuessKind kind;
     Eigen::Isometry3d motion;  // reference <- current
   };
+  // The last frame judged good: where a frame falls back to when the keyframe is out of reach.
+  struct GoodFrame {
+    std::shared_ptr<const LabeledCloud> cloud;
+    double stamp = 0.0;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    Matrix6d covariance = Matrix6d::Zero();
+  };
   Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
                   double dt);
   // The guesses to try, in order, and those kept for a retry.
@@ -142,6 +149,7 @@ class KeyframeOdometry {
   // `cloud` becomes the reference at the current pose; none when it is missing or has fewer
   // than min_tracking_points.
   void setReference(const std::shared_ptr<const LabeledCloud>& cloud, double stamp);
+  void setReference(const GoodFrame& frame);
   void lose(OdometryUpdate& update, const OdometryFrame& frame, const std::string& why);
   // The base-frame pose, motion and covariances of `update` from the camera-frame chain.
   void fillBaseFrame(OdometryUpdate& update, const Matrix6d& motion_covariance);
@@ -151,6 +159,8 @@ class KeyframeOdometry {
   // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
   std::optional<std::pair<double, double>> reference_self_, source_self_;
   double reference_stamp_ = 0.0;
+  std::optional<double> reference_first_cosine_;  // of the first frame registered to it
+  std::optional<GoodFrame> last_good_;
   Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();
   Matrix6d reference_covariance_ = Matrix6d::Zero();
   std::optional<double> last_stamp_;

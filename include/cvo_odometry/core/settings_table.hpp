@@ -104,7 +104,7 @@ template <class E, std::enable_if_t<std::is_enum_v<E>, int> = 0>
 std::string settingType(E) {
   std::string out;
   for (const auto& entry : enumNames(E{}))
-    out += (out.empty() ? "" : "|") + std::string(entry.name);
+    out += (out.empty() ? "" : " / ") + std::string(entry.name);
   return out;
 }
 

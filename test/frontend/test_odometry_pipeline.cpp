@@ -1,0 +1,122 @@
+// OdometryPipeline on real TUM frames: repeated images are stale and change nothing else, bad
+// input is classified the same way for every caller, and the base-frame outputs follow
+// base <- camera.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "cvo_odometry/frontend/builtin_presets.hpp"
+#include "cvo_odometry/frontend/odometry_pipeline.hpp"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+
+namespace {
+
+const std::string kTum = std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz";
+
+cvo::OdometrySettings tumSettings() {
+  cvo::OdometrySettings settings;
+  cvo::applyPreset("tum_rgbd", &settings);
+  settings.depth_scale = 5000.0;
+  settings.cvo.backend = cvo::BackendChoice::kCpu;
+  return settings;
+}
+
+cvo::RgbdFrame tumFrame(const cvo::TumSequence& sequence, std::size_t k) {
+  cvo::RgbdFrame frame;
+  sequence.load(k, &frame.image, &frame.depth);
+  frame.intrinsics = cvo::tumIntrinsics("fr1");
+  return frame;
+}
+
+TEST(OdometryPipeline, RepeatedImagesAreStaleAndChangeNothingElse) {
+  const cvo::TumSequence sequence(kTum);
+  const auto stamp = [&](std::size_t k) { return sequence.frames()[k].depth_stamp; };
+  cvo::OdometryPipeline plain(tumSettings()), repeated(tumSettings());
+  std::size_t stale = 0, bursts = 0;
+  for (std::size_t k = 0; k < 10; ++k) {
+    const cvo::RgbdFrame frame = tumFrame(sequence, k);
+    const cvo::PipelineResult a = plain.process(stamp(k), frame);
+    const cvo::PipelineResult b = repeated.process(stamp(k), frame);
+    ASSERT_EQ(b.outcome, cvo::FrameOutcome::kProcessed);
+    EXPECT_LT((a.update.pose.matrix() - b.update.pose.matrix()).norm(), 1e-12) << "frame " << k;
+    // A driver repeating images between this frame and the next: colour only, depth only, both
+    // (twice), each with a new stamp.
+    if (k + 1 == 10) break;
+    cvo::RgbdFrame colour_repeat = tumFrame(sequence, k + 1), depth_repeat = colour_repeat;
+    colour_repeat.image = frame.image.clone();
+    depth_repeat.depth = frame.depth.clone();
+    const double between = 0.5 * (stamp(k) + stamp(k + 1));
+    const std::vector<cvo::RgbdFrame> repeats =
+        k % 3 == 0   ? std::vector<cvo::RgbdFrame>{colour_repeat}
+        : k % 3 == 1 ? std::vector<cvo::RgbdFrame>{depth_repeat}
+                     : std::vector<cvo::RgbdFrame>{frame, frame};
+    for (std::size_t r = 0; r < repeats.size(); ++r) {
+      const cvo::PipelineResult s =
+          repeated.process(between + 1e-3 * static_cast<double>(r), repeats[r]);
+      EXPECT_EQ(s.outcome, cvo::FrameOutcome::kStale) << "after frame " << k;
+      EXPECT_NE(s.why.find(k % 3 == 0 ? "colour" : "depth"), std::string::npos) << s.why;
+      ++stale;
+      bursts += s.stale_burst_start;
+    }
+  }
+  EXPECT_EQ(stale, 12u);
+  EXPECT_EQ(bursts, 9u) << "one log line per run of stale frames";
+}
+
+TEST(OdometryPipeline, BadInputIsClassifiedOnce) {
+  const cvo::TumSequence sequence(kTum);
+  cvo::OdometryPipeline pipeline(tumSettings());
+  const double t0 = 100.0, dt = 1.0 / 30.0;
+  EXPECT_EQ(pipeline.process(t0, tumFrame(sequence, 0)).update.state,
+            cvo::TrackingState::kFirstFrame);
+  // Mismatched sizes: skipped, not a frame.
+  cvo::RgbdFrame small = tumFrame(sequence, 1);
+  cv::resize(small.depth, small.depth, cv::Size(320, 240), 0, 0, cv::INTER_NEAREST);
+  cvo::PipelineResult r = pipeline.process(t0 + dt, small);
+  EXPECT_EQ(r.outcome, cvo::FrameOutcome::kSkipped);
+  EXPECT_NE(r.why.find("320x240"), std::string::npos) << r.why;
+  // No valid depth: a lost frame.
+  cvo::RgbdFrame no_depth = tumFrame(sequence, 1);
+  no_depth.depth.setTo(0);
+  r = pipeline.process(t0 + 2 * dt, no_depth);
+  ASSERT_EQ(r.outcome, cvo::FrameOutcome::kProcessed);
+  EXPECT_EQ(r.update.state, cvo::TrackingState::kLost);
+  EXPECT_FALSE(r.update.trusted());
+  // The same stamp again: skipped.
+  r = pipeline.process(t0 + 2 * dt, tumFrame(sequence, 2));
+  EXPECT_EQ(r.outcome, cvo::FrameOutcome::kSkipped);
+  EXPECT_NE(r.why.find("second frame with stamp"), std::string::npos) << r.why;
+  r = pipeline.process(t0 + 3 * dt, tumFrame(sequence, 3));
+  EXPECT_EQ(r.update.state, cvo::TrackingState::kTracking) << r.update.problem;
+  // Time going backwards (a looping bag): the odometry restarts from that frame.
+  r = pipeline.process(t0, tumFrame(sequence, 4));
+  ASSERT_EQ(r.outcome, cvo::FrameOutcome::kProcessed);
+  EXPECT_EQ(r.update.state, cvo::TrackingState::kFirstFrame);
+  EXPECT_NE(r.why.find("time went backwards"), std::string::npos) << r.why;
+}
+
+TEST(OdometryPipeline, BaseFrameOutputsFollowTheCameraMount) {
+  const cvo::TumSequence sequence(kTum);
+  Eigen::Isometry3d B = Eigen::Isometry3d::Identity();  // base <- camera: looking along base x
+  B.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  B.translation() << 0.1, 0.0, 0.3;
+  cvo::OdometryPipeline pipeline(tumSettings());
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.translation() << 1.0, 2.0, 0.0;
+  pipeline.reset(start);
+  const cvo::PipelineResult first = pipeline.process(1.0, tumFrame(sequence, 0), B);
+  EXPECT_LT((first.update.base_pose.matrix() - start.matrix()).norm(), 1e-12);
+  EXPECT_GT(first.update.twist_covariance(0, 0), 1e3) << "no twist known yet";
+  const cvo::PipelineResult second = pipeline.process(1.0 + 1.0 / 30, tumFrame(sequence, 1), B);
+  const Eigen::Isometry3d expected = start * B * second.update.pose * B.inverse();
+  EXPECT_LT((second.update.base_pose.matrix() - expected.matrix()).norm(), 1e-9);
+  // The twist: the camera's motion in base axes over the interval.
+  const cvo::Vector6d twist = second.update.baseTwist();
+  const Eigen::Vector3d velocity =
+      (B * second.update.motion * B.inverse()).translation() / second.update.frame_interval;
+  EXPECT_LT((twist.head<3>() - velocity).norm(), 1e-9);
+  EXPECT_GT(second.update.pose_covariance(0, 0), 0.0);
+  EXPECT_LT(second.update.pose_covariance(0, 0), 1e-4) << "a trusted registration is tight";
+}
+
+}  // namespace

@@ -1,0 +1,153 @@
+// The ROS layer without a master: every dynamic_reconfigure field is a settings-table row with
+// the same default and range, the mapping both ways refuses what validate() refuses, README's
+// parameter table is the table's, and the messages are built from a pipeline result as the
+// nodelet publishes them.
+#include <gtest/gtest.h>
+
+#include <boost/any.hpp>
+#include <fstream>
+#include <sstream>
+
+#include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/ros/ros_conversions.hpp"
+#include "cvo_odometry/ros/settings_reconfigure.hpp"
+
+namespace {
+
+using cvo_odometry::CvoOdometryConfig;
+
+std::string anyText(const boost::any& value) {
+  if (const auto* d = boost::any_cast<double>(&value)) return cvo::settingText(*d);
+  if (const auto* i = boost::any_cast<int>(&value)) return cvo::settingText(*i);
+  if (const auto* b = boost::any_cast<bool>(&value)) return cvo::settingText(*b);
+  return boost::any_cast<std::string>(value);
+}
+
+double anyNumber(const boost::any& value) {
+  if (const auto* d = boost::any_cast<double>(&value)) return *d;
+  return static_cast<double>(boost::any_cast<int>(value));
+}
+
+TEST(RosSettings, EveryReconfigureFieldIsATableRowWithItsDefaultAndRange) {
+  const auto rows = cvo::settingRows(cvo::NodeSettings());
+  const auto& descriptions = CvoOdometryConfig::__getParamDescriptions__();
+  ASSERT_GT(descriptions.size(), 20u);
+  for (const auto& description : descriptions) {
+    const auto row = std::find_if(rows.begin(), rows.end(),
+                                  [&](const auto& r) { return r.name == description->name; });
+    ASSERT_NE(row, rows.end()) << description->name << " is in the cfg but not the table";
+    boost::any value;
+    description->getValue(CvoOdometryConfig::__getDefault__(), value);
+    EXPECT_EQ(anyText(value), row->value) << description->name << ": default";
+    if (description->type == "double" || description->type == "int") {
+      description->getValue(CvoOdometryConfig::__getMin__(), value);
+      EXPECT_DOUBLE_EQ(anyNumber(value), row->min) << description->name << ": min";
+      description->getValue(CvoOdometryConfig::__getMax__(), value);
+      EXPECT_DOUBLE_EQ(anyNumber(value), row->max) << description->name << ": max";
+    }
+  }
+}
+
+TEST(RosSettings, ReconfigureMapsBothWaysAndRefusesNonsense) {
+  cvo::NodeSettings settings;
+  settings.odometry.cvo.ell_min = 0.03;
+  settings.odometry.cvo.backend = cvo::BackendChoice::kCpu;
+  const CvoOdometryConfig config = cvo::toConfig(settings);
+  EXPECT_DOUBLE_EQ(config.ell_min, 0.03);
+  EXPECT_EQ(config.backend, "cpu");
+  const cvo::NodeSettings back = cvo::applyConfig(config, cvo::NodeSettings());
+  EXPECT_EQ(cvo::describeSettings(back), cvo::describeSettings(settings));
+  CvoOdometryConfig bad = config;
+  bad.ell_init = 0.01;  // below ell_min
+  EXPECT_THROW(cvo::applyConfig(bad, settings), std::invalid_argument);
+  bad = config;
+  bad.backend = "gpu";
+  EXPECT_THROW(cvo::applyConfig(bad, settings), std::invalid_argument);
+}
+
+TEST(RosSettings, ReadmeCarriesTheGeneratedTable) {
+  std::ifstream in(std::string(CVO_SOURCE_DIR) + "/README.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find(cvo::settingsMarkdown(cvo::NodeSettings())), std::string::npos)
+      << "README's parameter table is out of date: run build/devel/lib/cvo_odometry/"
+         "cvo_settings_table README.md";
+}
+
+TEST(RosConversions, OdometryMessageFromAnUpdate) {
+  cvo::OdometryUpdate update;
+  update.state = cvo::TrackingState::kTracking;
+  update.frame_interval = 0.1;
+  update.base_pose.translation() << 1.0, 2.0, 3.0;
+  update.base_frame_motion.translation() << 0.05, 0.0, 0.0;
+  update.base_frame_motion.linear() =
+      Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  update.pose_covariance = cvo::Matrix6d::Identity() * 2e-4;
+  update.twist_covariance = cvo::Matrix6d::Identity() * 3e-3;
+  const nav_msgs::Odometry odom = cvo::odometryMsg(update, ros::Time(5.0), "odom", "base_link");
+  EXPECT_EQ(odom.header.frame_id, "odom");
+  EXPECT_EQ(odom.child_frame_id, "base_link");
+  EXPECT_DOUBLE_EQ(odom.pose.pose.position.y, 2.0);
+  EXPECT_NEAR(odom.twist.twist.linear.x, 0.5, 1e-12);
+  EXPECT_NEAR(odom.twist.twist.angular.z, 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(odom.pose.covariance[7], 2e-4);
+  EXPECT_DOUBLE_EQ(odom.twist.covariance[35], 3e-3);
+  const auto tf = cvo::odometryTransformMsg(odom);
+  EXPECT_EQ(tf.child_frame_id, "base_link");
+  EXPECT_DOUBLE_EQ(tf.transform.translation.z, 3.0);
+}
+
+TEST(RosConversions, IndicatorMessageFromAResult) {
+  cvo::PipelineResult result;
+  result.update.state = cvo::TrackingState::kLost;
+  result.update.problem = "cosine 0.1 < min_cosine 0.5";
+  result.update.stamp = 10.0;
+  result.update.dt = 0.2;
+  result.update.guess = cvo::GuessKind::kFeatures;
+  result.update.attempts = 3;
+  result.prior = cvo::MotionPrior();
+  result.prior->inliers = 42;
+  const auto msg = cvo::indicatorMsg(result, ros::Time(10.0), "odom", {12.5, 3});
+  EXPECT_EQ(msg.state, "lost");
+  EXPECT_FALSE(msg.trusted);
+  EXPECT_EQ(msg.problem, result.update.problem);
+  EXPECT_EQ(msg.guess, "features");
+  EXPECT_EQ(msg.prior_inliers, 42u);
+  EXPECT_EQ(msg.attempts, 3);
+  EXPECT_DOUBLE_EQ(msg.reference_stamp, 9.8);
+  EXPECT_DOUBLE_EQ(msg.latency_ms, 12.5);
+  EXPECT_EQ(msg.dropped_frames, 3u);
+}
+
+TEST(RosConversions, FramesFromMessagesRefuseWhatTheyCannotRead) {
+  sensor_msgs::Image image, depth;
+  image.width = depth.width = 4;
+  image.height = depth.height = 3;
+  image.encoding = "bgr8";
+  image.step = 12;
+  image.data.assign(36, 100);
+  depth.encoding = "32FC1";
+  depth.step = 16;
+  depth.data.assign(48, 0);
+  sensor_msgs::CameraInfo info;
+  info.width = 4, info.height = 3;
+  info.K = {2, 0, 2, 0, 2, 1.5, 0, 0, 1};
+  const cvo::CameraFrame frame = cvo::rgbdFrameFromMsgs(image, info, depth, nullptr);
+  EXPECT_EQ(std::get<cvo::RgbdFrame>(frame).image.cols, 4);
+  image.encoding = "bgr16";
+  EXPECT_THROW(cvo::rgbdFrameFromMsgs(image, info, depth, nullptr), std::invalid_argument);
+  image.encoding = "bgr8";
+  info.K[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(cvo::rgbdFrameFromMsgs(image, info, depth, nullptr), std::invalid_argument);
+  EXPECT_THROW(cvo::stereoFrameFromMsgs(image, info, nullptr, nullptr, nullptr),
+               std::invalid_argument);
+}
+
+TEST(RosConversions, TheDefaultCameraLooksAlongTheBaseXAxis) {
+  const Eigen::Isometry3d B = cvo::opticalFrameInBase();
+  EXPECT_NEAR((B.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitX()).norm(), 0, 1e-12);
+  EXPECT_NEAR((B.linear() * Eigen::Vector3d::UnitY() + Eigen::Vector3d::UnitZ()).norm(), 0, 1e-12);
+  EXPECT_NEAR(B.linear().determinant(), 1.0, 1e-12);
+}
+
+}  // namespace
