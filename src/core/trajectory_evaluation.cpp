@@ -1,5 +1,7 @@
 #include "cvo_odometry/core/trajectory_evaluation.hpp"
 
+#include <set>
+
 #include <algorithm>
 #include <cmath>
 
@@ -50,17 +52,24 @@ RpeResult rpeOverPairs(const AssociatedPoses& p,
 
 }  // namespace
 
+const std::vector<EnumName<Association>>& enumNames(Association) {
+  static const std::vector<EnumName<Association>> names{{Association::kInterpolate, "interpolate"},
+                                                        {Association::kNearest, "nearest"}};
+  return names;
+}
+
 AssociatedPoses associate(const Trajectory& ground_truth, const Trajectory& estimate,
                           double max_gap, Association mode) {
   AssociatedPoses out;
   for (const auto& sample : estimate.poses()) {
     Eigen::Isometry3d gt;
-    if (mode == Association::kInterpolate) {
-      if (!ground_truth.interpolate(sample.stamp, max_gap, &gt)) continue;
-    } else {
+    const bool interpolated =
+        mode == Association::kInterpolate && ground_truth.interpolate(sample.stamp, max_gap, &gt);
+    if (!interpolated) {
       const long k = ground_truth.nearest(sample.stamp, max_gap);
       if (k < 0) continue;
       gt = ground_truth[static_cast<std::size_t>(k)].pose;
+      if (mode == Association::kInterpolate) ++out.nearest_fallbacks;
     }
     out.stamps.push_back(sample.stamp);
     out.ground_truth.push_back(gt);
@@ -158,6 +167,26 @@ DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<do
   if (result.count > 0) {
     result.translation_percent = 100.0 * t_sum / static_cast<double>(result.count);
     result.rotation_deg_per_m = kRadToDeg * r_sum / static_cast<double>(result.count);
+  }
+  return result;
+}
+
+SilentFailures countSilentFailures(const AssociatedPoses& poses,
+                                   const std::vector<double>& trusted_stamps, double fraction,
+                                   double min_error_m, double max_rotation_deg) {
+  SilentFailures result;
+  const std::set<double> trusted(trusted_stamps.begin(), trusted_stamps.end());
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    if (!trusted.count(poses.stamps[k])) continue;
+    const Eigen::Isometry3d truth = poses.ground_truth[k - 1].inverse() * poses.ground_truth[k];
+    const Eigen::Isometry3d step = poses.estimate[k - 1].inverse() * poses.estimate[k];
+    const Eigen::Isometry3d error = truth.inverse() * step;
+    const double t = error.translation().norm();
+    const double r = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
+    ++result.judged;
+    if ((t > fraction * truth.translation().norm() && t > min_error_m) || r > max_rotation_deg) {
+      ++result.failures;
+    }
   }
   return result;
 }

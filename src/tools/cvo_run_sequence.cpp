@@ -2,6 +2,7 @@
 // with the trajectory written out and, given ground truth, evaluated (and plotted).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
+#include "cvo_odometry/tools/evaluation_options.hpp"
 #include "cvo_odometry/tools/stage_timer.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
 #include "cvo_odometry/tools/tracking_tally.hpp"
@@ -17,13 +19,35 @@
 namespace {
 
 const char* kUsage =
-    "usage: cvo_run_sequence (--tum DIR | --kitti DIR) [options]\n"
+    "usage: cvo_run_sequence (--tum DIR | --kitti DIR | --7scenes DIR) [options]\n"
     "  --first N --last N      frame range (0 .. all)\n"
     "  --out FILE --format tum|kitti   trajectory output (TUM for --tum, KITTI for --kitti)\n"
-    "  --gt FILE               ground truth (TUM, or KITTI poses stamped by times.txt)\n"
-    "  --drift-lengths L,...   drift sub-sequence lengths in m (KITTI: 100,...,800)\n"
+    "  --gt FILE               ground truth (TUM, or KITTI poses stamped by times.txt; 7-Scenes:\n"
+    "                          its pose files unless given)\n"
     "  --plot FILE.png         estimated vs ground-truth trajectory, seen from above\n"
     "  --quiet                 no per-frame lines\n";
+
+// The spread of the points' depths over a run: a depth scale wrong by a factor shows here.
+class DepthRange {
+ public:
+  void add(const cvo::LabeledCloud& cloud) {
+    for (std::size_t i = 0; i < cloud.size(); i += 97)
+      depths_.push_back(cloud.position(i).z());
+  }
+  void print(std::ostream& out) {
+    if (depths_.empty()) return;
+    std::sort(depths_.begin(), depths_.end());
+    const auto at = [&](double q) {
+      return depths_[static_cast<std::size_t>(q * (depths_.size() - 1))];
+    };
+    out << std::fixed << std::setprecision(2) << "point depths: " << at(0.05) << " .. " << at(0.95)
+        << " m (5th..95th percentile), median " << at(0.5)
+        << " m: a wrong --depth-scale shows as depths too small or too large\n";
+  }
+
+ private:
+  std::vector<float> depths_;
+};
 
 // A progress bar on the terminal (stderr).
 void progress(std::size_t done, std::size_t total, double fps) {
@@ -40,13 +64,16 @@ void progress(std::size_t done, std::size_t total, double fps) {
 int main(int argc, char** argv) {
   try {
     auto names = cvo::sharedOptionNames();
-    names.insert(names.end(), {"first", "last", "out", "format", "gt", "drift-lengths", "plot"});
+    names.insert(names.end(), {"first", "last", "out", "format", "gt", "plot"});
+    const auto evaluation = cvo::evaluationOptionNames();
+    names.insert(names.end(), evaluation.begin(), evaluation.end());
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "quiet"});
     if (cli.has("help")) {
-      std::cout << kUsage << cvo::sharedOptionsUsage();
+      std::cout << kUsage << cvo::sharedOptionsUsage() << cvo::kEvaluationOptionsUsage;
       return 0;
     }
-    const cvo::OdometrySettings settings = cvo::settingsFrom(cli);
+    std::string preset_note;
+    const cvo::OdometrySettings settings = cvo::settingsFrom(cli, &preset_note);
     const cvo::CvoParams& params = settings.cvo;
     const cvo::SequenceInput input = cvo::openSequence(cli);
     cvo::OdometryPipeline pipeline(settings);
@@ -61,6 +88,7 @@ int main(int argc, char** argv) {
               << " frames, backend " << pipeline.backendName() << ", step "
               << cvo::toString(params.step_method) << ", colour "
               << (params.use_color ? "on" : "off") << "\n";
+    std::cerr << "cvo_run_sequence: " << preset_note << "\n";
     if (!pipeline.backendNote().empty()) {
       std::cerr << "cvo_run_sequence: " << pipeline.backendNote() << "\n";
     }
@@ -69,6 +97,8 @@ int main(int argc, char** argv) {
     cvo::StageTimer timer;
     const auto start = std::chrono::steady_clock::now();
     cvo::TrackingTally tally;
+    DepthRange depths;
+    std::vector<double> trusted;
     for (std::size_t k = first; k <= last; ++k) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
@@ -80,6 +110,8 @@ int main(int argc, char** argv) {
       tally.add(result);
       if (result.outcome == cvo::FrameOutcome::kProcessed) {
         if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
+        if (update.has_pose && update.trusted()) trusted.push_back(input.stamps[k]);
+        if (result.cloud) depths.add(*result.cloud);
         timer.add("frontend", result.stats.time_ms);
         if (update.attempts > 0) {
           timer.add("registration", update.report.time_ms);
@@ -116,6 +148,7 @@ int main(int argc, char** argv) {
       }
     }
     tally.print(std::cout);
+    depths.print(std::cout);
     timer.print(std::cout);
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))
@@ -123,14 +156,16 @@ int main(int argc, char** argv) {
       cvo::writeTrajectory(cli.get("out"), trajectory, format);
       std::cout << "trajectory: " << cli.get("out") << "\n";
     }
-    if (cli.has("gt")) {
-      const std::string gt_path = cli.get("gt");
-      const auto gt_format = cvo::detectTrajectoryFormat(gt_path);
-      const cvo::Trajectory ground_truth = cvo::readTrajectory(
-          gt_path, gt_format, gt_format == cvo::TrajectoryFormat::kKitti ? input.times_path : "");
-      cvo::EvaluationOptions options;
-      options.drift_lengths_m = cli.getDoubleList("drift-lengths", options.drift_lengths_m);
-      const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options);
+    if (cli.has("gt") || !input.ground_truth.empty()) {
+      cvo::Trajectory ground_truth = input.ground_truth;
+      if (cli.has("gt")) {
+        const std::string gt_path = cli.get("gt");
+        const auto gt_format = cvo::detectTrajectoryFormat(gt_path);
+        ground_truth = cvo::readTrajectory(
+            gt_path, gt_format, gt_format == cvo::TrajectoryFormat::kKitti ? input.times_path : "");
+      }
+      const cvo::EvaluationOptions options = cvo::evaluationOptionsFrom(cli);
+      const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options, &trusted);
       cvo::printEvaluationReport(std::cout, report, options);
       if (cli.has("plot")) {
         cvo::plotTrajectories(cli.get("plot"), ground_truth, trajectory, report.ate.alignment,

@@ -19,14 +19,20 @@ struct EvaluationOptions {
 struct EvaluationReport {
   std::size_t estimated_poses = 0;
   std::size_t associated_poses = 0;
+  std::size_t nearest_fallbacks = 0;  // see AssociatedPoses
   AteResult ate;
   RpeResult rpe_frame;
   RpeResult rpe_delta;
   DriftResult drift;
+  bool judged_trust = false;  // trusted stamps were given
+  SilentFailures silent;
 };
 
+// `trusted_stamps`, when given, are the frames the odometry called trusted: the report then
+// counts its silent failures.
 EvaluationReport evaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
-                                    const EvaluationOptions& options);
+                                    const EvaluationOptions& options,
+                                    const std::vector<double>* trusted_stamps = nullptr);
 void printEvaluationReport(std::ostream& out, const EvaluationReport& report,
                            const EvaluationOptions& options);
 

@@ -7,14 +7,17 @@
 
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/settings_table.hpp"
 #include "cvo_odometry/core/trajectory.hpp"
 
 namespace cvo {
 
 enum class Association {
-  kInterpolate,  // ground truth interpolated at each estimate's stamp (for dense ground truth)
+  kInterpolate,  // ground truth interpolated at each estimate's stamp (for dense ground truth);
+                 // where its samples are too far apart, the nearest one within max_gap
   kNearest       // the ground-truth sample nearest in time
 };
+const std::vector<EnumName<Association>>& enumNames(Association);
 
 // Estimated poses matched with ground truth at the estimate's stamps.
 struct AssociatedPoses {
@@ -22,6 +25,8 @@ struct AssociatedPoses {
   std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> ground_truth;
   std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>> estimate;
   std::size_t size() const { return stamps.size(); }
+  // Interpolation asked for, the nearest sample taken: the samples were too far apart.
+  std::size_t nearest_fallbacks = 0;
 };
 
 // Estimates with no ground truth within `max_gap` seconds are left out.
@@ -62,5 +67,16 @@ struct DriftResult {
 DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<double>& lengths_m,
                               int step = 10);
 std::vector<double> kittiDriftLengths();
+
+// Frames the odometry called trusted whose motion from the previous frame is wrong: translation
+// error above both `fraction` of the ground-truth step and `min_error_m`, or rotation error
+// above `max_rotation_deg`. A "silent failure": a wrong pose reported as right.
+struct SilentFailures {
+  std::size_t judged = 0;  // trusted frames with ground truth at them and the previous one
+  std::size_t failures = 0;
+};
+SilentFailures countSilentFailures(const AssociatedPoses& poses,
+                                   const std::vector<double>& trusted_stamps, double fraction = 0.5,
+                                   double min_error_m = 0.02, double max_rotation_deg = 1.0);
 
 }  // namespace cvo
