@@ -154,7 +154,9 @@ PhotometricRotationResult refineRotationPhotometrically(
                   " deg > photometric_max_correction");
   }
   out.transform.linear() = lie::orthonormalized(T).linear();
-  out.transform.translation() = reference_from_current.translation();
+  out.transform.translation() = params.photometric_translation
+                                    ? Eigen::Vector3d(T.translation())
+                                    : Eigen::Vector3d(reference_from_current.translation());
   return finish("");
 }
 

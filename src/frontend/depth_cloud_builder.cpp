@@ -85,7 +85,8 @@ DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
 
 LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth,
                                       const PinholeIntrinsics& intrinsics,
-                                      const cv::Mat& semantics_image, FrontendStats* stats) {
+                                      const cv::Mat& semantics_image, FrontendStats* stats,
+                                      FrameImages* images) {
   const auto start = std::chrono::steady_clock::now();
   if (image.empty()) throw std::invalid_argument("colour image is empty");
   if (depth.empty()) throw std::invalid_argument("depth image is empty");
@@ -136,10 +137,14 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     throw EmptyFrameError("every selected pixel belongs to an ignored class");
   }
   cloud.setImage(intensityImage(image, intrinsics, options_.image_levels));
+  if (images) *images = FrameImages{grey, depth};
   local.valid_depth_pixels = valid_count;
   local.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (stats) *stats = local;
+  if (stats) {
+    local.matching_ms = stats->matching_ms;
+    *stats = local;
+  }
   return cloud;
 }
 

@@ -31,6 +31,7 @@ OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFact
   odometry_ = makeOdometry(settings_);
   rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(settings_.rgbdOptions());
   stereo_builder_ = std::make_unique<StereoCloudBuilder>(settings_.stereoOptions());
+  tracker_ = std::make_unique<FeatureTracker>(settings_.features);
 }
 
 std::unique_ptr<KeyframeOdometry> OdometryPipeline::makeOdometry(const OdometrySettings& settings) {
@@ -48,6 +49,7 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   // Build everything new first: a refusal leaves the pipeline as it was.
   auto rgbd = std::make_unique<RgbdCloudBuilder>(settings.rgbdOptions());
   auto stereo = std::make_unique<StereoCloudBuilder>(settings.stereoOptions());
+  auto tracker = std::make_unique<FeatureTracker>(settings.features);
   const bool new_backend = settings.cvo.backend != settings_.cvo.backend ||
                            settings.cvo.num_threads != settings_.cvo.num_threads;
   std::unique_ptr<KeyframeOdometry> odometry;
@@ -55,6 +57,7 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   settings_ = settings;
   rgbd_builder_ = std::move(rgbd);
   stereo_builder_ = std::move(stereo);
+  tracker_ = std::move(tracker);  // its keyframe's corners are reseeded at the next keyframe
   if (new_backend) {
     odometry_ = std::move(odometry);
     reset(start_pose_);
@@ -67,6 +70,8 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
 void OdometryPipeline::reset(const Eigen::Isometry3d& base_pose) {
   start_pose_ = base_pose;
   odometry_->reset(base_pose);
+  tracker_->reset();
+  prior_pose_ = prior_keyframe_pose_ = prior_step_ = Eigen::Isometry3d::Identity();
   stale_.reset();
   stale_burst_ = false;
 }
@@ -81,12 +86,28 @@ std::string OdometryPipeline::staleness(const CameraFrame& frame) {
 }
 
 std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,
-                                                                 FrontendStats* stats) {
+                                                                 FrontendStats* stats,
+                                                                 FrameImages* images) {
   if (const auto* rgbd = std::get_if<RgbdFrame>(&frame)) {
-    return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats));
+    return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats, images));
   }
   return std::make_shared<const LabeledCloud>(
-      stereo_builder_->build(std::get<StereoFrame>(frame), stats));
+      stereo_builder_->build(std::get<StereoFrame>(frame), stats, images));
+}
+
+void OdometryPipeline::advancePriorPose(PipelineResult& result) {
+  const OdometryUpdate& update = result.update;
+  if (update.firstFrame() || !result.prior) {
+    if (!update.firstFrame()) prior_pose_ = prior_pose_ * prior_step_;  // no prior: keep going
+  } else {
+    const Eigen::Isometry3d pose = result.prior->solved
+                                       ? prior_keyframe_pose_ * result.prior->motion
+                                       : prior_pose_ * prior_step_;
+    prior_step_ = prior_pose_.inverse() * pose;
+    prior_pose_ = pose;
+  }
+  result.prior_pose = prior_pose_;
+  if (update.new_keyframe) prior_keyframe_pose_ = prior_pose_;
 }
 
 PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
@@ -116,8 +137,12 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   OdometryFrame input;
   input.stamp = stamp;
   input.base_from_camera = base_from_camera;
+  FrameImages images;
+  const PinholeIntrinsics& intrinsics = std::holds_alternative<RgbdFrame>(frame)
+                                            ? std::get<RgbdFrame>(frame).intrinsics
+                                            : std::get<StereoFrame>(frame).intrinsics;
   try {
-    input.cloud = buildCloud(frame, &result.stats);
+    input.cloud = buildCloud(frame, &result.stats, &images);
   } catch (const EmptyFrameError& e) {
     input.why_no_cloud = e.what();  // well-formed, nothing to track: a lost frame
   } catch (const std::invalid_argument& e) {
@@ -126,6 +151,10 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     return result;
   }
   stale_.accept();
+  if (settings_.features.enabled && tracker_->seeded() && !images.grey.empty()) {
+    input.prior = tracker_->track(images.grey, intrinsics);
+    result.prior = input.prior;
+  }
   result.cloud = input.cloud;
   result.reference = odometry_->referenceCloud();
   try {
@@ -135,6 +164,13 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     result.why = std::string("registration rejected the frame: ") + e.what();
     return result;
   }
+  if (result.update.state == TrackingState::kReset || result.update.firstFrame()) {
+    tracker_->reset();  // a new trajectory: the corners are the new keyframe's
+  }
+  if (settings_.features.enabled && result.update.new_keyframe && !images.grey.empty()) {
+    tracker_->seed(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
+  }
+  advancePriorPose(result);
   result.total_ms = millisecondsSince(start);
   return result;
 }

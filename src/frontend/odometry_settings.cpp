@@ -6,6 +6,7 @@ void OdometrySettings::validate() const {
   cvo.validate();
   cloud.validate();
   stereo.validate();
+  features.validate();
   if (!(depth_scale > 0.0)) throw std::invalid_argument("depth_scale must be positive");
 }
 

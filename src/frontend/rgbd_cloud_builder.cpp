@@ -10,12 +10,13 @@ namespace cvo {
 RgbdCloudBuilder::RgbdCloudBuilder(const RgbdFrontendOptions& options)
     : options_(options), cloud_builder_(options.cloud) {}
 
-LabeledCloud RgbdCloudBuilder::build(const RgbdFrame& frame, FrontendStats* stats) {
+LabeledCloud RgbdCloudBuilder::build(const RgbdFrame& frame, FrontendStats* stats,
+                                     FrameImages* images) {
   const auto start = std::chrono::steady_clock::now();
   const cv::Mat depth = depthToMetres(frame.depth, options_.depth_units_per_metre,
                                       options_.cloud.min_depth, options_.cloud.max_depth);
   LabeledCloud cloud =
-      cloud_builder_.build(frame.image, depth, frame.intrinsics, frame.semantics, stats);
+      cloud_builder_.build(frame.image, depth, frame.intrinsics, frame.semantics, stats, images);
   if (stats) {
     stats->time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -39,11 +39,17 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
                            options_.cloud.min_depth, options_.cloud.max_depth);
 }
 
-LabeledCloud StereoCloudBuilder::build(const StereoFrame& frame, FrontendStats* stats) {
+LabeledCloud StereoCloudBuilder::build(const StereoFrame& frame, FrontendStats* stats,
+                                       FrameImages* images) {
   const auto start = std::chrono::steady_clock::now();
   if (frame.left.empty()) throw std::invalid_argument("left image is empty");
+  const cv::Mat metres = depth(frame);
+  FrontendStats local;
+  local.matching_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   LabeledCloud cloud =
-      cloud_builder_.build(frame.left, depth(frame), frame.intrinsics, frame.semantics, stats);
+      cloud_builder_.build(frame.left, metres, frame.intrinsics, frame.semantics, &local, images);
+  if (stats) *stats = local;
   if (stats) {
     stats->time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

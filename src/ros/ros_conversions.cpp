@@ -293,6 +293,7 @@ cvo_odometry::CvoIndicator indicatorMsg(const PipelineResult& result, const ros:
     indicator.prior_ms = result.prior->time_ms;
   }
   indicator.track_agreement = update.track_agreement;
+  indicator.track_error_px = update.track_error_px;
   indicator.new_keyframe = update.new_keyframe;
   indicator.reference_stamp = update.stamp - update.dt;
   indicator.indicator = update.report.indicator_after;

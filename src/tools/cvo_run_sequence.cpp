@@ -21,7 +21,9 @@ namespace {
 const char* kUsage =
     "usage: cvo_run_sequence (--tum DIR | --kitti DIR | --7scenes DIR) [options]\n"
     "  --first N --last N      frame range (0 .. all)\n"
+    "  --stride N              every N-th frame of the range (larger motions per frame)\n"
     "  --out FILE --format tum|kitti   trajectory output (TUM for --tum, KITTI for --kitti)\n"
+    "  --prior-out FILE        the feature prior's own trajectory, in the same format\n"
     "  --gt FILE               ground truth (TUM, or KITTI poses stamped by times.txt; 7-Scenes:\n"
     "                          its pose files unless given)\n"
     "  --plot FILE.png         estimated vs ground-truth trajectory, seen from above\n"
@@ -64,7 +66,8 @@ void progress(std::size_t done, std::size_t total, double fps) {
 int main(int argc, char** argv) {
   try {
     auto names = cvo::sharedOptionNames();
-    names.insert(names.end(), {"first", "last", "out", "format", "gt", "plot"});
+    names.insert(names.end(),
+                 {"first", "last", "stride", "out", "prior-out", "format", "gt", "plot"});
     const auto evaluation = cvo::evaluationOptionNames();
     names.insert(names.end(), evaluation.begin(), evaluation.end());
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "quiet"});
@@ -83,8 +86,10 @@ int main(int argc, char** argv) {
     const std::size_t last = std::min(
         total - 1, static_cast<std::size_t>(cli.getInt("last", static_cast<int>(total) - 1)));
     if (first > last) throw std::invalid_argument("--first is after --last");
+    const int stride = cli.getInt("stride", 1);
+    if (stride < 1) throw std::invalid_argument("--stride must be >= 1");
     const bool tty = isatty(STDERR_FILENO) && !cli.has("quiet");
-    std::cerr << "cvo_run_sequence: " << input.kind << ", " << (last - first + 1)
+    std::cerr << "cvo_run_sequence: " << input.kind << ", " << (last - first) / stride + 1
               << " frames, backend " << pipeline.backendName() << ", step "
               << cvo::toString(params.step_method) << ", colour "
               << (params.use_color ? "on" : "off") << "\n";
@@ -93,13 +98,13 @@ int main(int argc, char** argv) {
       std::cerr << "cvo_run_sequence: " << pipeline.backendNote() << "\n";
     }
 
-    cvo::Trajectory trajectory;
+    cvo::Trajectory trajectory, prior_trajectory;
     cvo::StageTimer timer;
     const auto start = std::chrono::steady_clock::now();
     cvo::TrackingTally tally;
     DepthRange depths;
     std::vector<double> trusted;
-    for (std::size_t k = first; k <= last; ++k) {
+    for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
       timer.add("decode", std::chrono::duration<double, std::milli>(
@@ -111,6 +116,8 @@ int main(int argc, char** argv) {
       if (result.outcome == cvo::FrameOutcome::kProcessed) {
         if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
         if (update.has_pose && update.trusted()) trusted.push_back(input.stamps[k]);
+        if (result.prior_pose) prior_trajectory.append(input.stamps[k], *result.prior_pose);
+        if (result.prior) timer.add("feature prior", result.prior->time_ms);
         if (result.cloud) depths.add(*result.cloud);
         timer.add("frontend", result.stats.time_ms);
         if (update.attempts > 0) {
@@ -119,11 +126,11 @@ int main(int argc, char** argv) {
           timer.add("total", result.total_ms);
         }
       }
-      const std::size_t done = k - first + 1;
+      const std::size_t done = (k - first) / stride + 1;
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (tty) {
-        progress(done, last - first + 1, done / elapsed);
+        progress(done, (last - first) / stride + 1, done / elapsed);
       } else if (!cli.has("quiet")) {
         std::cerr << "frame " << k << ": ";
         if (result.outcome != cvo::FrameOutcome::kProcessed) {
@@ -135,13 +142,22 @@ int main(int argc, char** argv) {
         if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
                     << std::fixed << update.report.time_ms << " ms, cosine " << std::setprecision(3)
-                    << update.cosine << ", guess " << cvo::toString(update.guess) << ", "
+                    << update.cosine << ", guess " << cvo::toString(update.guess) << ", tracks "
+                    << (result.prior ? result.prior->inliers : 0) << " agree "
+                    << update.track_agreement << " (median " << update.track_error_px << " px of "
+                    << update.track_flow_px << " px), "
                     << (update.report.converged ? "converged" : update.report.message);
         }
         if (update.state != cvo::TrackingState::kTracking) {
           std::cerr << ", " << cvo::toString(update.state);
         }
         if (update.new_keyframe) std::cerr << ", keyframe";
+        if (!update.photometric.skipped.empty()) {
+          std::cerr << ", photometric skipped: " << update.photometric.skipped;
+        } else if (update.photometric.applied) {
+          std::cerr << ", photometric " << std::setprecision(3) << update.photometric.correction_deg
+                    << " deg";
+        }
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         if (!result.why.empty()) std::cerr << " [" << result.why << "]";
         std::cerr << "\n";
@@ -156,6 +172,11 @@ int main(int argc, char** argv) {
       cvo::writeTrajectory(cli.get("out"), trajectory, format);
       std::cout << "trajectory: " << cli.get("out") << "\n";
     }
+    if (cli.has("prior-out")) {
+      const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))
+                                            : input.trajectory_format;
+      cvo::writeTrajectory(cli.get("prior-out"), prior_trajectory, format);
+    }
     if (cli.has("gt") || !input.ground_truth.empty()) {
       cvo::Trajectory ground_truth = input.ground_truth;
       if (cli.has("gt")) {
@@ -167,6 +188,11 @@ int main(int argc, char** argv) {
       const cvo::EvaluationOptions options = cvo::evaluationOptionsFrom(cli);
       const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options, &trusted);
       cvo::printEvaluationReport(std::cout, report, options);
+      if (prior_trajectory.size() >= 2) {
+        std::cout << "feature prior alone (KLT + PnP over the same keyframes), for comparison:\n";
+        cvo::printEvaluationReport(
+            std::cout, cvo::evaluateTrajectory(ground_truth, prior_trajectory, options), options);
+      }
       if (cli.has("plot")) {
         cvo::plotTrajectories(cli.get("plot"), ground_truth, trajectory, report.ate.alignment,
                               "cvo_odometry " + input.kind);

@@ -85,8 +85,10 @@ struct CvoParams {
   // The photometric rotation stage after CVO (photometric_rotation.hpp); needs clouds that
   // carry their image (the RGB-D front end attaches it).
   bool photometric_rotation = true;
-  int photometric_iterations = 10;
+  int photometric_iterations = 30;
   double photometric_max_correction = 2.0;
+  // Keep the stage's translation too (where depth and image are simultaneous: stereo).
+  bool photometric_translation = false;
 
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;
@@ -118,9 +120,13 @@ struct CvoParams {
   double guess_disagreement_translation = 0.05;  // m
   double guess_disagreement_rotation = 2.0;      // deg
   // A confident prior (min_prior_inliers, min_prior_inlier_ratio) judges every registration:
-  // at least min_track_agreement of its inliers within track_agreement_px.
-  double track_agreement_px = 3.0;
+  // at least min_track_agreement of its inliers within track_agreement_px plus
+  // track_agreement_ratio times their image motion (motion_prior.hpp: trackAgreement).
+  double track_agreement_px = 5.0;
+  double track_agreement_ratio = 0.5;
   double min_track_agreement = 0.5;
+  // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.
+  double tracked_cosine_ratio = 0.25;
 
   // Throws std::invalid_argument naming the first parameter that makes no sense.
   void validate() const;

@@ -89,6 +89,9 @@ void visitSettings(CvoParams& p, V&& v) {
   v(SettingInfo{"photometric_max_correction", "photometric",
                 "larger rotation corrections (deg) are refused", 0.01, 30.0},
     p.photometric_max_correction);
+  v(SettingInfo{"photometric_translation", "photometric",
+                "keep the stage's translation too (stereo: depth and image are simultaneous)"},
+    p.photometric_translation);
   // Where the sums run
   v(SettingInfo{"backend", "backend", "auto: the GPU when one is usable, else the CPU"}, p.backend);
   v(SettingInfo{"num_threads", "backend", "CPU threads (0: all cores)", 0, 1024}, p.num_threads);
@@ -148,12 +151,20 @@ void visitSettings(CvoParams& p, V&& v) {
                 "a feature track agrees with a registration within this reprojection error (px)",
                 0.1, 100.0},
     p.track_agreement_px);
+  v(SettingInfo{"track_agreement_ratio", "tracking",
+                "... plus this fraction of the track's image motion since the keyframe", 0.0, 0.99},
+    p.track_agreement_ratio);
   v(
       SettingInfo{
           "min_track_agreement", "tracking",
           "a confident prior trusts a registration only if this fraction of its inliers agrees",
           0.0, 1.0},
       p.min_track_agreement);
+  v(SettingInfo{"tracked_cosine_ratio", "tracking",
+                "a registration the tracks judge needs a cosine of only this fraction of "
+                "min_cosine",
+                0.0, 1.0},
+    p.tracked_cosine_ratio);
 }
 
 }  // namespace cvo

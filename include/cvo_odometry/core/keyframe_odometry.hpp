@@ -68,6 +68,8 @@ struct OdometryUpdate {
   bool new_keyframe = false;           // this frame is the reference from now on
   GuessKind guess = GuessKind::kNone;  // of the registration used
   double track_agreement = -1.0;       // of the registration used; -1: not judged
+  double track_error_px = -1.0;        // its median reprojection error of the prior's inliers
+  double track_flow_px = -1.0;         // their median image motion since the keyframe
   // In the base frame (REP-105: odom <- base_link), base = base_from_camera of the trajectory.
   Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d base_frame_motion = Eigen::Isometry3d::Identity();  // previous <- current
@@ -116,6 +118,8 @@ class KeyframeOdometry {
     GuessKind guess = GuessKind::kNone;
     double cosine = 0.0;
     double agreement = -1.0;
+    double track_error_px = -1.0;
+    double track_flow_px = -1.0;
     std::string problems;
     bool good = false;
   };

@@ -27,9 +27,18 @@ struct MotionPrior {
   double time_ms = 0.0;
 };
 
-// The fraction of the prior's inlier tracks that `motion` (keyframe <- current) reprojects within
-// `max_error_px` of where the current image sees them; -1 without tracks.
-double trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d& motion,
-                      double max_error_px);
+// How well `motion` (keyframe <- current) explains the prior's inlier tracks: the fraction it
+// reprojects within `max_error_px` plus `flow_ratio` times the track's own image motion since
+// the keyframe of where the current image sees it, and the median error (px); -1 without
+// tracks. The flow term keeps a constant lag between the tracks' image and the geometry's
+// depth (an RGB-D camera's) from failing good registrations, while one stuck near the
+// keyframe's pose is off by a whole flow and fails.
+struct TrackAgreement {
+  double fraction = -1.0;
+  double median_px = -1.0;
+  double median_flow_px = -1.0;  // how far the tracks moved in the image since the keyframe
+};
+TrackAgreement trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d& motion,
+                              double max_error_px, double flow_ratio);
 
 }  // namespace cvo

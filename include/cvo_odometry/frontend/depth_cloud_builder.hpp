@@ -32,7 +32,15 @@ struct CloudBuilderOptions {
 struct FrontendStats {
   SelectionStats selection;
   std::size_t valid_depth_pixels = 0;
+  double matching_ms = 0.0;  // stereo matching, part of time_ms
   double time_ms = 0.0;
+};
+
+// What the front end made of a frame besides its cloud: the grey image and the metric depth
+// (CV_32FC1, NaN where invalid), for the feature tracker.
+struct FrameImages {
+  cv::Mat grey;
+  cv::Mat depth;
 };
 
 // The grey image for the photometric stage: `levels` blurs of `image` (8-bit BGR or grey), or
@@ -56,7 +64,7 @@ class DepthCloudBuilder {
   // one is in an ignored class.
   LabeledCloud build(const cv::Mat& image, const cv::Mat& depth_metres,
                      const PinholeIntrinsics& intrinsics, const cv::Mat& semantics,
-                     FrontendStats* stats);
+                     FrontendStats* stats, FrameImages* images = nullptr);
 
   const CloudBuilderOptions& options() const { return options_; }
 

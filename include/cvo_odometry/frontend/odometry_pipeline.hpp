@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 
 #include "cvo_odometry/core/keyframe_odometry.hpp"
+#include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/frontend/stale_frame_detector.hpp"
 
@@ -43,6 +44,9 @@ struct PipelineResult {
   std::shared_ptr<const LabeledCloud> cloud;      // the frame's cloud, when it had one
   std::shared_ptr<const LabeledCloud> reference;  // what it was registered to, if anything
   std::optional<MotionPrior> prior;               // the feature prior, when it ran
+  // The feature prior's own odometry (start <- current, camera): its motions chained over the
+  // keyframes, constant velocity where it found none. A peer to compare with, never published.
+  std::optional<Eigen::Isometry3d> prior_pose;
   double total_ms = 0.0;
 };
 
@@ -75,7 +79,10 @@ class OdometryPipeline {
   std::unique_ptr<KeyframeOdometry> makeOdometry(const OdometrySettings& settings);
   // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
   // throws std::invalid_argument.
-  std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats);
+  std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
+                                                 FrameImages* images);
+  // The prior's own pose for this frame, and its keyframe when the odometry took a new one.
+  void advancePriorPose(PipelineResult& result);
   std::string staleness(const CameraFrame& frame);
 
   OdometrySettings settings_;
@@ -84,7 +91,11 @@ class OdometryPipeline {
   std::unique_ptr<KeyframeOdometry> odometry_;
   std::unique_ptr<RgbdCloudBuilder> rgbd_builder_;
   std::unique_ptr<StereoCloudBuilder> stereo_builder_;
+  std::unique_ptr<FeatureTracker> tracker_;
   StaleFrameDetector stale_;
+  Eigen::Isometry3d prior_pose_ = Eigen::Isometry3d::Identity();  // of the last frame
+  Eigen::Isometry3d prior_keyframe_pose_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d prior_step_ = Eigen::Isometry3d::Identity();  // last frame to frame
   bool stale_burst_ = false;
   Eigen::Isometry3d start_pose_ = Eigen::Isometry3d::Identity();
 };

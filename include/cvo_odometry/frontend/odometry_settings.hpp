@@ -6,6 +6,7 @@
 
 #include "cvo_odometry/core/cvo_settings.hpp"
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
+#include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_matcher.hpp"
@@ -16,6 +17,7 @@ struct OdometrySettings {
   CvoParams cvo;
   CloudBuilderOptions cloud;
   StereoMatcherOptions stereo;
+  FeatureTrackerOptions features;
   double depth_scale = 1000.0;  // 16-bit depth units per metre
 
   // Throws std::invalid_argument naming the first setting that makes no sense.
@@ -61,6 +63,27 @@ void visitSettings(OdometrySettings& s, V&& v) {
   v(SettingInfo{"block_size", "stereo", "SGBM block size (odd)", 1, 21}, s.stereo.block_size);
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
+  v(SettingInfo{"feature_prior", "features",
+                "track the keyframe's corners (KLT + PnP): a motion guess and a check "
+                "independent of CVO"},
+    s.features.enabled);
+  v(SettingInfo{"feature_corners", "features", "most corners seeded per keyframe", 8, 10000},
+    s.features.max_corners);
+  v(SettingInfo{"feature_min_distance", "features", "least distance between corners (px)", 1.0,
+                200.0},
+    s.features.min_distance);
+  v(SettingInfo{"klt_window", "features", "KLT window (px)", 5, 101}, s.features.window);
+  v(SettingInfo{"klt_levels", "features", "KLT pyramid levels above the image", 0, 8},
+    s.features.levels);
+  v(SettingInfo{"klt_max_error", "features",
+                "a track is kept when its backward track returns within this (px)", 0.01, 20.0},
+    s.features.max_flow_error);
+  v(SettingInfo{"pnp_ransac_px", "features", "PnP inlier threshold (px)", 0.1, 50.0},
+    s.features.ransac_px);
+  v(SettingInfo{"feature_reseed_fraction", "features",
+                "a new keyframe when fewer than this fraction of its corners are still tracked",
+                0.0, 1.0},
+    s.features.reseed_fraction);
 }
 
 // Defaults, then the preset at `path` (empty: none), validated; FormatError names the file and

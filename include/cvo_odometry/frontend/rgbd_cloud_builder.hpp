@@ -25,7 +25,8 @@ class RgbdCloudBuilder {
 
   // Throws std::invalid_argument naming the problem: empty images, mismatched sizes, an
   // unsupported encoding, intrinsics that make no sense, or no pixel with valid depth.
-  LabeledCloud build(const RgbdFrame& frame, FrontendStats* stats = nullptr);
+  LabeledCloud build(const RgbdFrame& frame, FrontendStats* stats = nullptr,
+                     FrameImages* images = nullptr);
 
   const RgbdFrontendOptions& options() const { return options_; }
 

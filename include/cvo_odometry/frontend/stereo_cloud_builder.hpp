@@ -30,7 +30,8 @@ class StereoCloudBuilder {
 
   // Throws std::invalid_argument naming the problem (no right image and no disparity, sizes that
   // differ, a baseline or intrinsics that make no sense, no valid depth, ...).
-  LabeledCloud build(const StereoFrame& frame, FrontendStats* stats = nullptr);
+  LabeledCloud build(const StereoFrame& frame, FrontendStats* stats = nullptr,
+                     FrameImages* images = nullptr);
 
   // Depth in metres (CV_32FC1, NaN invalid) of the frame, from its disparity or by matching.
   cv::Mat depth(const StereoFrame& frame) const;

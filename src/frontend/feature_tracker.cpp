@@ -1,0 +1,172 @@
+#include "cvo_odometry/frontend/feature_tracker.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace cvo {
+
+namespace {
+
+// Fewest tracks a PnP solution is worth trying with.
+constexpr std::size_t kMinTracks = 8;
+
+std::vector<cv::Point2f> normalised(const std::vector<cv::Point2f>& pixels,
+                                    const PinholeIntrinsics& K) {
+  std::vector<cv::Point2f> out(pixels.size());
+  if (pixels.empty()) return out;
+  if (K.distortion.empty()) {
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      out[k] = cv::Point2f(static_cast<float>((pixels[k].x - K.cx) / K.fx),
+                           static_cast<float>((pixels[k].y - K.cy) / K.fy));
+    }
+    return out;
+  }
+  const cv::Matx33d camera(K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+  cv::undistortPoints(pixels, out, camera, K.distortion);
+  return out;
+}
+
+}  // namespace
+
+void FeatureTrackerOptions::validate() const {
+  if (max_corners < static_cast<int>(kMinTracks)) {
+    throw std::invalid_argument("feature_corners must be >= " + std::to_string(kMinTracks));
+  }
+  if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
+      !(ransac_px > 0.0) || reseed_fraction < 0.0 || reseed_fraction > 1.0) {
+    throw std::invalid_argument("feature tracker options make no sense");
+  }
+}
+
+FeatureTracker::FeatureTracker(const FeatureTrackerOptions& options) : options_(options) {
+  options_.validate();
+}
+
+void FeatureTracker::reset() {
+  points_.clear();
+  pixels_.clear();
+  last_pyramid_.clear();
+  last_image_ = nullptr;
+  seeded_ = 0;
+}
+
+std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
+  std::vector<cv::Mat> levels;
+  cv::buildOpticalFlowPyramid(grey, levels, cv::Size(options_.window, options_.window),
+                              options_.levels);
+  return levels;
+}
+
+void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& K,
+                          int crop_top_rows) {
+  points_.clear();
+  pixels_.clear();
+  seeded_ = 0;
+  if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
+  cv::Mat mask = (depth == depth);  // NaN: no depth
+  mask.rowRange(0, std::min(std::max(crop_top_rows, 0), mask.rows)).setTo(0);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(grey, corners, options_.max_corners, 0.01, options_.min_distance, mask, 3,
+                          false);
+  const std::vector<cv::Point2f> rays = normalised(corners, K);
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const float z = depth.at<float>(cvRound(corners[k].y), cvRound(corners[k].x));
+    if (!std::isfinite(z) || !(z > 0.0f)) continue;
+    points_.emplace_back(rays[k].x * z, rays[k].y * z, z);
+    pixels_.push_back(corners[k]);
+  }
+  seeded_ = points_.size();
+  if (last_image_ != grey.data || last_pyramid_.empty()) last_pyramid_ = pyramid(grey);
+  last_image_ = grey.data;
+}
+
+MotionPrior FeatureTracker::track(const cv::Mat& grey, const PinholeIntrinsics& K) {
+  const auto start = std::chrono::steady_clock::now();
+  MotionPrior prior;
+  const auto finish = [&](const std::string& problem) {
+    prior.problem = problem;
+    prior.time_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return prior;
+  };
+  if (points_.empty() || last_pyramid_.empty()) return finish("no keyframe corners to track");
+  std::vector<cv::Mat> current = pyramid(grey);
+  const cv::Size window(options_.window, options_.window);
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  std::vector<cv::Point2f> forward, backward;
+  std::vector<unsigned char> ok_forward, ok_backward;
+  std::vector<float> errors;
+  cv::calcOpticalFlowPyrLK(last_pyramid_, current, pixels_, forward, ok_forward, errors, window,
+                           options_.levels, stop);
+  backward = pixels_;
+  cv::calcOpticalFlowPyrLK(current, last_pyramid_, forward, backward, ok_backward, errors, window,
+                           options_.levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < pixels_.size(); ++k) {
+    const cv::Point2f& p = forward[k];
+    const bool inside = p.x >= 0 && p.y >= 0 && p.x < grey.cols && p.y < grey.rows;
+    if (!ok_forward[k] || !ok_backward[k] || !inside ||
+        cv::norm(backward[k] - pixels_[k]) > options_.max_flow_error) {
+      continue;
+    }
+    points_[kept] = points_[k];
+    pixels_[kept] = p;
+    ++kept;
+  }
+  points_.resize(kept);
+  pixels_.resize(kept);
+  last_pyramid_ = std::move(current);
+  last_image_ = grey.data;
+  prior.tracks = static_cast<int>(kept);
+  prior.wants_keyframe = kept < options_.reseed_fraction * static_cast<double>(seeded_);
+  if (kept < kMinTracks) return finish("only " + std::to_string(kept) + " corners tracked");
+
+  const std::vector<cv::Point2f> observed = normalised(pixels_, K);
+  const double focal = 0.5 * (K.fx + K.fy);
+  const double threshold = options_.ransac_px / focal;
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  const cv::Matx33d identity = cv::Matx33d::eye();
+  const bool solved =
+      cv::solvePnPRansac(points_, observed, identity, cv::noArray(), rvec, tvec, false, 100,
+                         static_cast<float>(threshold), 0.999, inliers, cv::SOLVEPNP_EPNP);
+  if (!solved || inliers.size() < 6) return finish("PnP found no consistent motion");
+  std::vector<cv::Point3f> inlier_points;
+  std::vector<cv::Point2f> inlier_observed;
+  for (int i : inliers) {
+    inlier_points.push_back(points_[static_cast<std::size_t>(i)]);
+    inlier_observed.push_back(observed[static_cast<std::size_t>(i)]);
+  }
+  cv::solvePnPRefineLM(inlier_points, inlier_observed, identity, cv::noArray(), rvec, tvec);
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Isometry3d current_from_keyframe = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c)
+      current_from_keyframe.linear()(r, c) = R(r, c);
+    current_from_keyframe.translation()[r] = tvec.at<double>(r);
+  }
+  if (!current_from_keyframe.matrix().allFinite()) return finish("PnP gave no finite motion");
+  prior.solved = true;
+  prior.motion = current_from_keyframe.inverse();
+  prior.focal_px = focal;
+  // The inliers of the refined motion are the tracks that judge CVO.
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const Eigen::Vector3d X(points_[k].x, points_[k].y, points_[k].z);
+    const Eigen::Vector2d x(observed[k].x, observed[k].y);
+    const Eigen::Vector3d p = current_from_keyframe * X;
+    if (!(p.z() > 1e-6) || (p.head<2>() / p.z() - x).norm() > threshold) continue;
+    prior.points.push_back(X);
+    prior.observations.push_back(x);
+  }
+  prior.inliers = static_cast<int>(prior.points.size());
+  prior.inlier_ratio = static_cast<double>(prior.inliers) / static_cast<double>(kept);
+  return finish("");
+}
+
+}  // namespace cvo
