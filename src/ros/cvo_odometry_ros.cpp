@@ -1,5 +1,6 @@
 #include "cvo_odometry/ros/cvo_odometry_ros.hpp"
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -663,6 +664,14 @@ void CvoOdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("backend fallbacks", backend_fallbacks_);
   status.add("resets", resets_);
   status.add("backend", odometry_->registration().backend().name());
+  if (mode_ == Mode::kRgbd) {
+    // The stamp of the latest rgb/camera_info (it is not synchronized with the images): shows
+    // that one arrives, and lets a test wait until the nodelet has the one it sent.
+    std::lock_guard<std::mutex> info_lock(info_mutex_);
+    char stamp[32] = "none yet";
+    if (rgb_info_) std::snprintf(stamp, sizeof stamp, "%.3f", rgb_info_->header.stamp.toSec());
+    status.add("latest camera_info stamp", std::string(stamp));
+  }
   last_problem_.clear();
 }
 
