@@ -10,9 +10,10 @@
 #   input's time (the slowest here takes well under 1 s);
 # - -use_cmp=0: libFuzzer's compare tracing feeds operands of the target's comparisons, pointers
 #   included, into its mutations, so with address randomisation two runs of the same commit
-#   mutated differently (fuzz_frontend: cov 610/674 after 20000 runs; with -use_cmp=0 the same
-#   764 every time). Compare-guided fuzzing stays on in test/fuzz/fuzz_longer.sh. (The stack
-#   depth feature, which varied the same way, is left out of the build: CMakeLists.txt.)
+#   mutated differently (fuzz_frontend from its seeds: cov 610 or 674 after 20000 runs; with
+#   -use_cmp=0, 764 in four runs). Compare-guided fuzzing stays on in test/fuzz/fuzz_longer.sh.
+#   (The stack depth feature, which varied the same way, is left out of the build:
+#   CMakeLists.txt.)
 # New inputs go to WORK_DIR/new (emptied first: an earlier run changes nothing, and the committed
 # corpus is only read), a crash to WORK_DIR/crash-*. Exits non-zero on any finding.
 set -euo pipefail
