@@ -1,5 +1,6 @@
 #include "cvo_odometry/frontend/stereo_matcher.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -19,8 +20,37 @@ void StereoMatcherOptions::validate() const {
   if (p1 < 0 || p2 < 0 || (p2 > 0 && p2 <= p1)) {
     throw std::invalid_argument("SGBM penalties need 0 <= p1 < p2 (or 0 for the defaults)");
   }
+  if (uniqueness_ratio < 0 || uniqueness_ratio > 99) {
+    // sgbm_3way divides by 100 - uniqueness_ratio
+    throw std::invalid_argument("uniqueness_ratio must be in [0, 99], got " +
+                                std::to_string(uniqueness_ratio));
+  }
   if (mode != "sgbm" && mode != "hh" && mode != "sgbm_3way") {
     throw std::invalid_argument("unknown SGBM mode '" + mode + "' (sgbm, hh or sgbm_3way)");
+  }
+}
+
+int StereoMatcherOptions::minImageWidth() const {
+  // 64-bit: min_disparity + num_disparities may not fit an int.
+  const long long max_disparity = static_cast<long long>(min_disparity) + num_disparities;
+  const long long width =
+      std::max(max_disparity, 0LL) - std::min(min_disparity, 0) + block_size / 2 + 1;
+  return static_cast<int>(std::min<long long>(width, std::numeric_limits<int>::max()));
+}
+
+void StereoMatcherOptions::checkImageSize(int cols, int rows) const {
+  if (cols < 1 || rows < 1) {
+    throw std::invalid_argument("stereo image is empty (" + std::to_string(cols) + "x" +
+                                std::to_string(rows) + ")");
+  }
+  if (cols < minImageWidth()) {
+    throw std::invalid_argument(
+        "stereo pair is " + std::to_string(cols) + "x" + std::to_string(rows) + " but SGBM (" +
+        mode + ", min_disparity " + std::to_string(min_disparity) + ", num_disparities " +
+        std::to_string(num_disparities) + ", block_size " + std::to_string(block_size) +
+        ") needs images at least " + std::to_string(minImageWidth()) +
+        " pixels wide (more than max(min_disparity + num_disparities, 0) - min(min_disparity, "
+        "0) + block_size / 2): lower num_disparities or use wider images");
   }
 }
 
@@ -44,6 +74,8 @@ cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right) cons
                                 std::to_string(left.rows) + " but right is " +
                                 std::to_string(right.cols) + "x" + std::to_string(right.rows));
   }
+  // Before OpenCV, which would not refuse it (StereoMatcherOptions::minImageWidth).
+  options_.checkImageSize(left.cols, left.rows);
   cv::Mat fixed_point;  // CV_16S, disparity * 16
   sgbm_->compute(toGrey(left), toGrey(right), fixed_point);
   cv::Mat pixels(fixed_point.size(), CV_32FC1);

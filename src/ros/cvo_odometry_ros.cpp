@@ -112,7 +112,13 @@ void CvoOdometryRos::subscribe() {
       OdometryDiagnostics::SyncState{
           [this] { return rgbd_sync_ ? rgbd_sync_->arrived() : stereo_sync_->arrived(); },
           [this] { return rgbd_sync_ ? rgbd_sync_->learnedOffset() : std::nullopt; },
-          [this] { return queue_.dropped(); }});
+          [this] { return queue_.dropped(); },
+          [this]() -> std::optional<double> {
+            if (rgbd_sync_ == nullptr) return std::nullopt;
+            std::lock_guard<std::mutex> lock(info_mutex_);
+            if (!rgb_info_) return std::nullopt;
+            return rgb_info_->header.stamp.toSec();
+          }});
   diagnostics_->setBackend(pipeline_->backendName());
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
   if (node.mode != CameraMode::kRgbd) {

@@ -1,5 +1,7 @@
 #include "cvo_odometry/ros/odometry_diagnostics.hpp"
 
+#include <cstdio>
+
 namespace cvo {
 
 OdometryDiagnostics::OdometryDiagnostics(ros::NodeHandle nh, ros::NodeHandle pnh, SyncState sync)
@@ -89,6 +91,12 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("backend fallbacks", fallbacks_);
   status.add("resets", resets_);
   status.add("backend", backend_);
+  if (sync_.camera_info_stamp) {
+    const std::optional<double> stamp = sync_.camera_info_stamp();
+    char text[32] = "none yet";
+    if (stamp) std::snprintf(text, sizeof text, "%.3f", *stamp);
+    status.add("latest camera_info stamp", std::string(text));
+  }
   last_problem_.clear();
 }
 

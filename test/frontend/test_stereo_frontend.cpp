@@ -3,7 +3,9 @@
 // stereo registration against the official ground truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -163,6 +165,84 @@ TEST(StereoFrontend, BadInputGetsAClearError) {
   cvo::StereoMatcherOptions odd;
   odd.num_disparities = 100;
   EXPECT_THROW(cvo::StereoMatcher{odd}, std::invalid_argument);
+}
+
+// OpenCV 4.6's SGBM matches columns max(min + num, 0) .. cols + min(min, 0) and needs that band
+// wider than block_size / 2 (StereoMatcherOptions::minImageWidth): sgbm_3way asks for a negative
+// buffer size when it is empty (fuzz regression sgbm_3way_narrower_than_disparity_range), and all
+// modes read past the band when it is narrower than half a block. Just inside the rule every mode
+// really matches (same answer twice); one column less is refused before OpenCV is called.
+TEST(StereoMatcher, SizeRuleForEveryModeJustInsideAndOutside) {
+  struct Case {
+    int min_disparity, num_disparities, block_size, min_width;
+  };
+  const Case cases[] = {{0, 16, 5, 19},  {0, 16, 11, 22}, {0, 32, 1, 33},
+                        {-8, 16, 3, 18}, {4, 16, 5, 23},  {0, 128, 5, 131}};
+  for (const std::string mode : {"sgbm", "hh", "sgbm_3way"}) {
+    for (const Case& c : cases) {
+      cvo::StereoMatcherOptions options;
+      options.mode = mode;
+      options.min_disparity = c.min_disparity;
+      options.num_disparities = c.num_disparities;
+      options.block_size = c.block_size;
+      const std::string what = mode + " min " + std::to_string(c.min_disparity) + " num " +
+                               std::to_string(c.num_disparities) + " block " +
+                               std::to_string(c.block_size);
+      ASSERT_EQ(options.minImageWidth(), c.min_width) << what;
+      const cvo::StereoMatcher matcher(options);
+      for (const int rows : {1, 2, 9}) {
+        cv::Mat left(rows, c.min_width, CV_8UC1), right(rows, c.min_width, CV_8UC1);
+        cv::theRNG().state = 16;
+        cv::randu(left, 0, 256);
+        cv::randu(right, 0, 256);
+        EXPECT_NO_THROW(options.checkImageSize(c.min_width, rows)) << what;
+        const cv::Mat first = matcher.disparity(left, right);
+        ASSERT_EQ(first.size(), left.size()) << what;
+        ASSERT_EQ(first.type(), CV_32FC1) << what;
+        const cv::Mat second = matcher.disparity(left, right);
+        EXPECT_TRUE(
+            std::equal(first.begin<float>(), first.end<float>(), second.begin<float>(),
+                       [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }))
+            << what << " rows " << rows;
+        const int narrow = c.min_width - 1;
+        EXPECT_THROW(options.checkImageSize(narrow, rows), std::invalid_argument) << what;
+        try {
+          matcher.disparity(left.colRange(0, narrow), right.colRange(0, narrow));
+          ADD_FAILURE() << what << ": a " << narrow << "-column pair was matched";
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("needs images at least " +
+                                               std::to_string(c.min_width) + " pixels wide"),
+                    std::string::npos)
+              << e.what();
+        }
+      }
+    }
+  }
+  cvo::StereoMatcherOptions options;
+  EXPECT_THROW(options.checkImageSize(0, 10), std::invalid_argument);
+  EXPECT_THROW(options.checkImageSize(200, 0), std::invalid_argument);
+  options.uniqueness_ratio = 100;  // sgbm_3way would divide by 100 - uniqueness_ratio
+  EXPECT_THROW(cvo::StereoMatcher{options}, std::invalid_argument);
+}
+
+// The fuzzer's finding through the whole front end: a 1x1 pair for a 16-disparity matcher.
+TEST(StereoFrontend, PairNarrowerThanTheDisparityRangeIsRefused) {
+  cvo::StereoFrontendOptions options;
+  options.matcher.num_disparities = 16;
+  cvo::StereoCloudBuilder builder(options);
+  cvo::StereoFrame frame;
+  frame.left = cv::Mat(1, 1, CV_8UC1, cv::Scalar(9));
+  frame.right = frame.left.clone();
+  frame.intrinsics = pairIntrinsics();
+  frame.intrinsics.width = frame.intrinsics.height = 1;
+  frame.intrinsics.cx = frame.intrinsics.cy = 0.5;
+  frame.baseline = kPairBaseline;
+  try {
+    builder.build(frame);
+    ADD_FAILURE() << "a 1x1 stereo pair was matched";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("stereo pair is 1x1"), std::string::npos) << e.what();
+  }
 }
 
 TEST(KittiSequence, ReadsCalibrationTimesAndImages) {

@@ -14,7 +14,7 @@ namespace {
 
 class LiveControl : public cvo_test::TumTopicDriver {
  protected:
-  void SetUp() override { connect({0, 1, 2, 3, 4, 5, 6, 7}, true); }
+  void SetUp() override { ASSERT_NO_FATAL_FAILURE(connect({0, 1, 2, 3, 4, 5, 6, 7}, true)); }
 
   // Frame `k` with its depth in an 8-bit encoding the nodelet must refuse.
   void publishMalformed(std::size_t k, double stamp) {
@@ -46,6 +46,8 @@ TEST_F(LiveControl, ReconfigureMalformedFramesTimeJumpAndReset) {
   ell_min.name = "ell_min";
   ell_min.value = 0.03;
   change.request.config.doubles.push_back(ell_min);
+  ASSERT_TRUE(
+      ros::service::waitForService("cvo_odometry/set_parameters", ros::Duration(kEventTimeout)));
   ASSERT_TRUE(ros::service::call("cvo_odometry/set_parameters", change));
   publish(2, t0 + 2 * dt);
   ASSERT_EQ(waitFor(3), 3u);
@@ -53,7 +55,8 @@ TEST_F(LiveControl, ReconfigureMalformedFramesTimeJumpAndReset) {
 
   // A malformed frame (8-bit depth) is skipped; the next good frame still gives odometry.
   publishMalformed(3, t0 + 3 * dt);
-  EXPECT_EQ(waitFor(4, 3.0), 3u) << "the malformed frame produced a report";
+  ASSERT_EQ(waitForSkipped(1), 1) << "the malformed frame was not skipped";
+  EXPECT_EQ(waitFor(3), 3u) << "the malformed frame produced a report";
   publish(4, t0 + 4 * dt);
   ASSERT_EQ(waitFor(4), 4u);
   EXPECT_FALSE(indicator(3).first_frame) << "odometry continues after a skipped frame";
@@ -68,6 +71,7 @@ TEST_F(LiveControl, ReconfigureMalformedFramesTimeJumpAndReset) {
 
   // The reset service restarts it too.
   std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::waitForService("cvo_odometry/reset", ros::Duration(kEventTimeout)));
   ASSERT_TRUE(ros::service::call("cvo_odometry/reset", reset));
   publish(7, t0 - 10.0 + 2 * dt);
   ASSERT_EQ(waitFor(7), 7u);

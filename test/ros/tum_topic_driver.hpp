@@ -1,10 +1,17 @@
 // Test fixture for rostest nodes that drive the nodelet with real TUM frames published on its
 // RGB-D topics (camera namespace) and collect what it publishes: indicators, odometry, the
 // debug cloud's fields and diagnostics.
+// It waits on events, never for a fixed time, so that a slow or loaded machine changes nothing
+// but how long the test takes: connections (publisher and subscriber counts), the nodelet's
+// acknowledgement of a camera_info (its "latest camera_info stamp" diagnostic), and counts
+// (indicators, the "skipped frames" diagnostic). The waits have generous deadlines, reached only
+// when something is broken. Publisher queues hold every frame a test sends, so none is dropped
+// however slowly the nodelet takes them.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -24,8 +31,13 @@ namespace cvo_test {
 
 class TumTopicDriver : public testing::Test {
  protected:
+  // Generous deadlines for events that take a few seconds at most on a loaded machine: reached
+  // only when something is broken, so they cost nothing on a good run.
+  static constexpr double kConnectTimeout = 120.0, kEventTimeout = 60.0;
+
   // Loads the fixture's frames `frames`, connects to the nodelet (segmentation topic too when
-  // `segmentation`), and publishes a camera_info unless told not to.
+  // `segmentation`), and publishes a camera_info unless told not to. Call with
+  // ASSERT_NO_FATAL_FAILURE.
   void connect(const std::vector<std::size_t>& frames, bool segmentation, bool camera_info = true) {
     const cvo::TumSequence sequence(std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz");
     for (std::size_t k : frames) {
@@ -35,16 +47,16 @@ class TumTopicDriver : public testing::Test {
       images_[k] = image;
       depths_[k] = metres;
     }
-    rgb_pub_ = nh_.advertise<sensor_msgs::Image>("rgb/image_rect_color", 5);
-    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("rgb/camera_info", 5, true);
-    depth_pub_ = nh_.advertise<sensor_msgs::Image>("depth_registered/image_rect", 5);
-    if (segmentation) labels_pub_ = nh_.advertise<sensor_msgs::Image>("segmentation/image", 5);
+    rgb_pub_ = nh_.advertise<sensor_msgs::Image>("rgb/image_rect_color", kQueue);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("rgb/camera_info", kQueue, true);
+    depth_pub_ = nh_.advertise<sensor_msgs::Image>("depth_registered/image_rect", kQueue);
+    if (segmentation) labels_pub_ = nh_.advertise<sensor_msgs::Image>("segmentation/image", kQueue);
     indicator_sub_ = nh_.subscribe<cvo_odometry::CvoIndicator>(
-        "indicator", 50, [this](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
+        "indicator", kQueue, [this](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
           std::lock_guard<std::mutex> lock(mutex_);
           indicators_.push_back(*msg);
         });
-    odom_sub_ = nh_.subscribe<nav_msgs::Odometry>("odom", 50,
+    odom_sub_ = nh_.subscribe<nav_msgs::Odometry>("odom", kQueue,
                                                   [this](const nav_msgs::Odometry::ConstPtr& msg) {
                                                     std::lock_guard<std::mutex> lock(mutex_);
                                                     odoms_.push_back(*msg);
@@ -65,15 +77,22 @@ class TumTopicDriver : public testing::Test {
               diagnostics_[kv.key] = kv.value;
           }
         });
-    if (camera_info) publishInfo(cameraInfo());
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
-    while ((depth_pub_.getNumSubscribers() == 0 || rgb_pub_.getNumSubscribers() == 0 ||
-            (segmentation && labels_pub_.getNumSubscribers() == 0) ||
-            indicator_sub_.getNumPublishers() == 0 || cloud_sub_.getNumPublishers() == 0) &&
-           ros::WallTime::now() < deadline) {
+    // Every connection up: the nodelet subscribed to what this node publishes (camera_info
+    // included) and publishes what it subscribes to, diagnostics included.
+    auto connected = [&] {
+      return depth_pub_.getNumSubscribers() > 0 && rgb_pub_.getNumSubscribers() > 0 &&
+             info_pub_.getNumSubscribers() > 0 &&
+             (!segmentation || labels_pub_.getNumSubscribers() > 0) &&
+             indicator_sub_.getNumPublishers() > 0 && odom_sub_.getNumPublishers() > 0 &&
+             cloud_sub_.getNumPublishers() > 0 && !diagnostic("frames").empty();
+    };
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kConnectTimeout);
+    while (!connected() && ros::ok() && ros::WallTime::now() < deadline)
       ros::WallDuration(0.1).sleep();
+    ASSERT_TRUE(connected()) << "no connection to the nodelet after " << kConnectTimeout << " s";
+    if (camera_info) {
+      ASSERT_NO_FATAL_FAILURE(publishInfo(cameraInfo()));
     }
-    ros::WallDuration(1.0).sleep();  // the nodelet's camera_info subscriber too
   }
 
   static sensor_msgs::CameraInfo cameraInfo() {
@@ -85,9 +104,17 @@ class TumTopicDriver : public testing::Test {
     return info;
   }
 
-  void publishInfo(const sensor_msgs::CameraInfo& info) {
+  // Publishes a camera_info (stamped 1, 2, 3, ... to tell them apart) and waits until the
+  // nodelet reports it as its latest, so that the next frame uses it. Call with
+  // ASSERT_NO_FATAL_FAILURE.
+  void publishInfo(sensor_msgs::CameraInfo info) {
+    info.header.stamp = ros::Time(static_cast<double>(++infos_));
     info_pub_.publish(info);
-    ros::WallDuration(0.5).sleep();  // latched, but the nodelet must have it before the frame
+    char expected[32];
+    std::snprintf(expected, sizeof expected, "%.3f", info.header.stamp.toSec());
+    const std::string latest =
+        diagnostic("latest camera_info stamp", [&](const std::string& v) { return v == expected; });
+    ASSERT_EQ(latest, expected) << "the nodelet did not take the camera_info";
   }
 
   static std_msgs::Header header(double stamp) {
@@ -121,7 +148,7 @@ class TumTopicDriver : public testing::Test {
   void publish(std::size_t k, double stamp) { publish(colour(k, stamp), depth(k, stamp)); }
 
   // Waits until `count` indicators arrived (or `timeout_s` passed); returns how many there are.
-  std::size_t waitFor(std::size_t count, double timeout_s = 20.0) {
+  std::size_t waitFor(std::size_t count, double timeout_s = kEventTimeout) {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
     while (ros::WallTime::now() < deadline) {
       {
@@ -146,25 +173,38 @@ class TumTopicDriver : public testing::Test {
     std::lock_guard<std::mutex> lock(mutex_);
     return cloud_fields_;
   }
-  // The latest value of a key of the nodelet's diagnostics ("" if not seen), waiting up to
-  // `timeout_s` for one that satisfies `ready`.
+  // Waits until the nodelet's diagnostics count `count` skipped frames (it publishes them once a
+  // second); returns the count seen. A skipped frame never gives an indicator, so after this the
+  // indicators show whether anything else was published.
+  long waitForSkipped(long count) {
+    const std::string skipped =
+        diagnostic("skipped frames", [&](const std::string& v) { return std::stol(v) >= count; });
+    return skipped.empty() ? 0 : std::stol(skipped);
+  }
+
+  // The latest value of a key of the nodelet's diagnostics ("" if not seen yet).
+  std::string diagnostic(const std::string& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = diagnostics_.find(key);
+    return it == diagnostics_.end() ? "" : it->second;
+  }
+  // The same, waiting up to `timeout_s` for one that satisfies `ready`.
   template <class Ready>
-  std::string diagnostic(const std::string& key, Ready ready, double timeout_s = 5.0) {
+  std::string diagnostic(const std::string& key, Ready ready, double timeout_s = kEventTimeout) {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
     std::string value;
     do {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        const auto it = diagnostics_.find(key);
-        value = it == diagnostics_.end() ? "" : it->second;
-      }
+      value = diagnostic(key);
       if (!value.empty() && ready(value)) break;
       ros::WallDuration(0.1).sleep();
     } while (ros::WallTime::now() < deadline);
     return value;
   }
 
+  static constexpr int kQueue = 100;  // more than any test sends: nothing dropped when slow
+
   ros::NodeHandle nh_;
+  int infos_ = 0;
   std::map<std::size_t, cv::Mat> images_, depths_;
   ros::Publisher rgb_pub_, info_pub_, depth_pub_, labels_pub_;
   ros::Subscriber indicator_sub_, odom_sub_, cloud_sub_, diagnostics_sub_;

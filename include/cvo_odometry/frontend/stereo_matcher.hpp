@@ -24,6 +24,20 @@ struct StereoMatcherOptions {
   std::string mode = "sgbm_3way";
 
   void validate() const;
+
+  // The narrowest pair OpenCV 4.6's StereoSGBM can match with these options, in every mode
+  // (modules/calib3d/src/stereosgbm.cpp): the matching band, columns minX1 = max(min_disparity
+  // + num_disparities, 0) to maxX1 = cols + min(min_disparity, 0) in computeDisparitySGBM (sgbm,
+  // hh) and SGBM3WayMainLoop (sgbm_3way), must be wider than block_size / 2. Otherwise
+  // sgbm_3way sizes its buffers from the band's negative width (an allocation of ~2^64 bytes),
+  // sgbm and hh return no disparity at all when the band is empty, and every mode sums its first
+  // block past the band's end (reads of other buffers: results that vary from run to run,
+  // OpenCV issue 25828; upstream refuses such pairs since its PR 27305, 2025). No rule on the
+  // height (1 row works).
+  int minImageWidth() const;
+  // Throws std::invalid_argument, naming the sizes and the rule, when a cols x rows pair is
+  // one the matcher cannot handle (narrower than minImageWidth(), or empty).
+  void checkImageSize(int cols, int rows) const;
 };
 
 class StereoMatcher {

@@ -23,6 +23,9 @@ class OdometryDiagnostics {
     std::function<std::size_t()> arrived;
     std::function<std::optional<double>()> offset;
     std::function<std::size_t()> dropped;  // frames dropped to keep latency bounded
+    // RGB-D: the stamp of the latest rgb/camera_info (not synchronized with the images), or
+    // nothing yet: shows that one arrives, and lets a test wait until the nodelet has it.
+    std::function<std::optional<double>()> camera_info_stamp;
   };
 
   OdometryDiagnostics(ros::NodeHandle nh, ros::NodeHandle pnh, SyncState sync);
