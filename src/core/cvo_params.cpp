@@ -80,8 +80,6 @@ void CvoParams::validate() const {
   requirePositive(guess_disagreement_translation, "guess_disagreement_translation");
   requirePositive(guess_disagreement_rotation, "guess_disagreement_rotation");
   requirePositive(track_agreement_px, "track_agreement_px");
-  require(track_agreement_ratio >= 0.0 && track_agreement_ratio < 1.0,
-          "track_agreement_ratio must be in [0, 1): a stuck registration is off by 1");
   require(min_track_agreement >= 0.0 && min_track_agreement <= 1.0,
           "min_track_agreement must be in [0, 1]");
   require(tracked_cosine_ratio >= 0.0 && tracked_cosine_ratio <= 1.0,

@@ -114,8 +114,10 @@ void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval
   const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(interval);
   const Guess still{GuessKind::kIdentity, stillMotion()};
   const bool confident = priorConfident(frame.prior);
+  // The prior moves the camera from the previous frame's pose.
   const Guess prior{GuessKind::kFeatures,
-                    confident ? frame.prior->motion : Eigen::Isometry3d::Identity()};
+                    confident ? lie::orthonormalized(stillMotion() * frame.prior->motion)
+                              : Eigen::Isometry3d::Identity()};
   const Guess constant{GuessKind::kConstantVelocity,
                        velocity ? *velocity : Eigen::Isometry3d::Identity()};
   switch (p.initial_guess) {
@@ -200,8 +202,11 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   }
   // The feature tracks, independent of CVO, catch a registration stuck near a wrong guess.
   if (priorConfident(frame.prior)) {
-    const TrackAgreement agreement = trackAgreement(*frame.prior, a.result.transform,
-                                                    p.track_agreement_px, p.track_agreement_ratio);
+    // The tracks' points are the previous frame's: the registration's motion over this step.
+    const Eigen::Isometry3d prior_from_current =
+        pose_.inverse() * reference_pose_ * a.result.transform;
+    const TrackAgreement agreement =
+        trackAgreement(*frame.prior, prior_from_current, p.track_agreement_px);
     a.agreement = agreement.fraction;
     a.track_error_px = agreement.median_px;
     a.track_flow_px = agreement.median_flow_px;
@@ -210,9 +215,8 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       why.precision(3);
       why << "feature tracks disagree: " << 100.0 * a.agreement << " % of "
           << frame.prior->points.size() << " inlier tracks within " << p.track_agreement_px
-          << " px + " << p.track_agreement_ratio << " x their image motion (median error "
-          << a.track_error_px << " px of " << a.track_flow_px << ") < min_track_agreement "
-          << p.min_track_agreement;
+          << " px (median error " << a.track_error_px << " px; they moved " << a.track_flow_px
+          << " px) < min_track_agreement " << p.min_track_agreement;
       a.good = false;
       a.problems = why.str();
     }
@@ -249,6 +253,9 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
     started_ = true;
   }
   if (params().forget_motion) velocity_.reset();
+  // The prior relates this frame to the previous one: when that was lost and placed by no
+  // prior of its own (a constant-velocity guess), its pose means nothing to the tracks.
+  if (lost_frames_ > 0 && !previous_placed_by_prior_) frame.prior.reset();
   if (!reference_) return startFrom(frame);
   const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
   OdometryUpdate update;
@@ -294,22 +301,30 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   }
   if (!chosen->good && last_good_ && last_good_->stamp != reference_stamp_) {
     // The keyframe is out of reach: register to the last good frame instead, which is nearer
-    // (this frame then becomes the keyframe). The prior's tracks belong to the keyframe: they
-    // neither guess nor judge here.
+    // (this frame then becomes the keyframe).
+    const GoodFrame keyframe{reference_, reference_stamp_, reference_pose_, reference_covariance_};
+    const auto keyframe_self = reference_self_;
+    const auto keyframe_first_cosine = reference_first_cosine_;
     setReference(*last_good_);
     update.dt = frame.stamp - reference_stamp_;
     update.reference_points = reference_->size();
-    OdometryFrame nearer = frame;
-    nearer.prior.reset();
     first.clear(), retries.clear();
-    chooseGuesses(nearer, update.frame_interval, &first, &retries);
+    chooseGuesses(frame, update.frame_interval, &first, &retries);
     first.insert(first.end(), retries.begin(), retries.end());
     for (const Guess& guess : first) {
       if (chosen->good) break;
-      Attempt a = attempt(*cloud, guess, nearer, update.dt);
+      Attempt a = attempt(*cloud, guess, frame, update.dt);
       ++update.attempts;
       problems += "; to the last good frame: " + a.problems;
       if (a.good) chosen = std::move(a), update.state = TrackingState::kRecovered;
+    }
+    if (!chosen->good) {
+      // Lost: the keyframe stays the reference.
+      setReference(keyframe);
+      reference_self_ = keyframe_self;
+      reference_first_cosine_ = keyframe_first_cosine;
+      update.dt = frame.stamp - reference_stamp_;
+      update.reference_points = reference_->size();
     }
   }
   update.problem = chosen->good && update.state != TrackingState::kRecovered ? "" : problems;
@@ -381,8 +396,7 @@ bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update,
          (reference_first_cosine_ &&
           update.cosine < p.keyframe_cosine_ratio * *reference_first_cosine_) ||
          update.motion.translation().norm() > p.keyframe_max_translation ||
-         angleDeg(update.motion) > p.keyframe_max_rotation ||
-         (frame.prior && frame.prior->wants_keyframe);
+         angleDeg(update.motion) > p.keyframe_max_rotation;
 }
 
 void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame) {
@@ -418,7 +432,8 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
   update.lost_frames = ++lost_frames_;
   // The best guess there is: the feature prior when confident, else constant velocity.
   const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(update.frame_interval);
-  update.motion = priorConfident(frame.prior) ? frame.prior->motion
+  previous_placed_by_prior_ = priorConfident(frame.prior);
+  update.motion = priorConfident(frame.prior) ? stillMotion() * frame.prior->motion
                   : velocity                  ? *velocity
                                               : stillMotion();
   const Matrix6d guessed = guessedMotionCovariance(p, update.frame_interval);

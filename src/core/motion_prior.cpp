@@ -6,23 +6,22 @@
 namespace cvo {
 
 TrackAgreement trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d& motion,
-                              double max_error_px, double flow_ratio) {
+                              double max_error_px) {
   TrackAgreement agreement;
   if (prior.points.empty() || !(prior.focal_px > 0.0)) return agreement;
-  const Eigen::Isometry3d current_from_keyframe = motion.inverse();
+  const Eigen::Isometry3d current_from_previous = motion.inverse();
   std::vector<double> errors, flows;
   errors.reserve(prior.points.size());
   for (std::size_t i = 0; i < prior.points.size(); ++i) {
     const Eigen::Vector3d& X = prior.points[i];
     flows.push_back(prior.focal_px * (X.head<2>() / X.z() - prior.observations[i]).norm());
-    const Eigen::Vector3d p = current_from_keyframe * prior.points[i];
+    const Eigen::Vector3d p = current_from_previous * prior.points[i];
     errors.push_back(p.z() > 1e-6
                          ? prior.focal_px * (p.head<2>() / p.z() - prior.observations[i]).norm()
                          : 1e9);  // behind the camera: as far off as can be
   }
-  std::size_t within = 0;
-  for (std::size_t i = 0; i < errors.size(); ++i)
-    within += errors[i] <= max_error_px + flow_ratio * flows[i];
+  const auto within =
+      std::count_if(errors.begin(), errors.end(), [&](double e) { return e <= max_error_px; });
   agreement.fraction = static_cast<double>(within) / static_cast<double>(errors.size());
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
   agreement.median_px = errors[errors.size() / 2];

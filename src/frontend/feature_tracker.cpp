@@ -38,7 +38,7 @@ void FeatureTrackerOptions::validate() const {
     throw std::invalid_argument("feature_corners must be >= " + std::to_string(kMinTracks));
   }
   if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
-      !(ransac_px > 0.0) || reseed_fraction < 0.0 || reseed_fraction > 1.0) {
+      !(ransac_px > 0.0)) {
     throw std::invalid_argument("feature tracker options make no sense");
   }
 }
@@ -51,8 +51,6 @@ void FeatureTracker::reset() {
   points_.clear();
   pixels_.clear();
   last_pyramid_.clear();
-  last_image_ = nullptr;
-  seeded_ = 0;
 }
 
 std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
@@ -63,10 +61,10 @@ std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
 }
 
 void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& K,
-                          int crop_top_rows) {
+                          int crop_top_rows, std::vector<cv::Mat> levels) {
   points_.clear();
   pixels_.clear();
-  seeded_ = 0;
+  last_pyramid_ = std::move(levels);
   if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
   cv::Mat mask = (depth == depth);  // NaN: no depth
   mask.rowRange(0, std::min(std::max(crop_top_rows, 0), mask.rows)).setTo(0);
@@ -80,22 +78,24 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
     points_.emplace_back(rays[k].x * z, rays[k].y * z, z);
     pixels_.push_back(corners[k]);
   }
-  seeded_ = points_.size();
-  if (last_image_ != grey.data || last_pyramid_.empty()) last_pyramid_ = pyramid(grey);
-  last_image_ = grey.data;
 }
 
-MotionPrior FeatureTracker::track(const cv::Mat& grey, const PinholeIntrinsics& K) {
+MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
+                                  const PinholeIntrinsics& K, int crop_top_rows) {
   const auto start = std::chrono::steady_clock::now();
-  MotionPrior prior;
-  const auto finish = [&](const std::string& problem) {
-    prior.problem = problem;
-    prior.time_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return prior;
-  };
-  if (points_.empty() || last_pyramid_.empty()) return finish("no keyframe corners to track");
   std::vector<cv::Mat> current = pyramid(grey);
+  MotionPrior prior =
+      points_.empty() || last_pyramid_.empty() ? MotionPrior{} : solve(current, grey.size(), K);
+  if (points_.empty()) prior.problem = "no corners of a previous frame to track";
+  seed(grey, depth, K, crop_top_rows, std::move(current));
+  prior.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return prior;
+}
+
+MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv::Size& size,
+                                  const PinholeIntrinsics& K) const {
+  MotionPrior prior;
   const cv::Size window(options_.window, options_.window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   std::vector<cv::Point2f> forward, backward;
@@ -106,67 +106,70 @@ MotionPrior FeatureTracker::track(const cv::Mat& grey, const PinholeIntrinsics& 
   backward = pixels_;
   cv::calcOpticalFlowPyrLK(current, last_pyramid_, forward, backward, ok_backward, errors, window,
                            options_.levels, stop, cv::OPTFLOW_USE_INITIAL_FLOW);
-  std::size_t kept = 0;
+  std::vector<cv::Point3f> points;
+  std::vector<cv::Point2f> pixels;
   for (std::size_t k = 0; k < pixels_.size(); ++k) {
     const cv::Point2f& p = forward[k];
-    const bool inside = p.x >= 0 && p.y >= 0 && p.x < grey.cols && p.y < grey.rows;
+    const bool inside = p.x >= 0 && p.y >= 0 && p.x < size.width && p.y < size.height;
     if (!ok_forward[k] || !ok_backward[k] || !inside ||
         cv::norm(backward[k] - pixels_[k]) > options_.max_flow_error) {
       continue;
     }
-    points_[kept] = points_[k];
-    pixels_[kept] = p;
-    ++kept;
+    points.push_back(points_[k]);
+    pixels.push_back(p);
   }
-  points_.resize(kept);
-  pixels_.resize(kept);
-  last_pyramid_ = std::move(current);
-  last_image_ = grey.data;
-  prior.tracks = static_cast<int>(kept);
-  prior.wants_keyframe = kept < options_.reseed_fraction * static_cast<double>(seeded_);
-  if (kept < kMinTracks) return finish("only " + std::to_string(kept) + " corners tracked");
-
-  const std::vector<cv::Point2f> observed = normalised(pixels_, K);
+  prior.tracks = static_cast<int>(points.size());
+  if (points.size() < kMinTracks) {
+    prior.problem = "only " + std::to_string(points.size()) + " corners tracked";
+    return prior;
+  }
+  const std::vector<cv::Point2f> observed = normalised(pixels, K);
   const double focal = 0.5 * (K.fx + K.fy);
   const double threshold = options_.ransac_px / focal;
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
   const cv::Matx33d identity = cv::Matx33d::eye();
   const bool solved =
-      cv::solvePnPRansac(points_, observed, identity, cv::noArray(), rvec, tvec, false, 100,
+      cv::solvePnPRansac(points, observed, identity, cv::noArray(), rvec, tvec, false, 100,
                          static_cast<float>(threshold), 0.999, inliers, cv::SOLVEPNP_EPNP);
-  if (!solved || inliers.size() < 6) return finish("PnP found no consistent motion");
+  if (!solved || inliers.size() < 6) {
+    prior.problem = "PnP found no consistent motion";
+    return prior;
+  }
   std::vector<cv::Point3f> inlier_points;
   std::vector<cv::Point2f> inlier_observed;
   for (int i : inliers) {
-    inlier_points.push_back(points_[static_cast<std::size_t>(i)]);
+    inlier_points.push_back(points[static_cast<std::size_t>(i)]);
     inlier_observed.push_back(observed[static_cast<std::size_t>(i)]);
   }
   cv::solvePnPRefineLM(inlier_points, inlier_observed, identity, cv::noArray(), rvec, tvec);
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);
-  Eigen::Isometry3d current_from_keyframe = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d current_from_previous = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c)
-      current_from_keyframe.linear()(r, c) = R(r, c);
-    current_from_keyframe.translation()[r] = tvec.at<double>(r);
+      current_from_previous.linear()(r, c) = R(r, c);
+    current_from_previous.translation()[r] = tvec.at<double>(r);
   }
-  if (!current_from_keyframe.matrix().allFinite()) return finish("PnP gave no finite motion");
+  if (!current_from_previous.matrix().allFinite()) {
+    prior.problem = "PnP gave no finite motion";
+    return prior;
+  }
   prior.solved = true;
-  prior.motion = current_from_keyframe.inverse();
+  prior.motion = current_from_previous.inverse();
   prior.focal_px = focal;
   // The inliers of the refined motion are the tracks that judge CVO.
-  for (std::size_t k = 0; k < points_.size(); ++k) {
-    const Eigen::Vector3d X(points_[k].x, points_[k].y, points_[k].z);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
     const Eigen::Vector2d x(observed[k].x, observed[k].y);
-    const Eigen::Vector3d p = current_from_keyframe * X;
+    const Eigen::Vector3d p = current_from_previous * X;
     if (!(p.z() > 1e-6) || (p.head<2>() / p.z() - x).norm() > threshold) continue;
     prior.points.push_back(X);
     prior.observations.push_back(x);
   }
   prior.inliers = static_cast<int>(prior.points.size());
-  prior.inlier_ratio = static_cast<double>(prior.inliers) / static_cast<double>(kept);
-  return finish("");
+  prior.inlier_ratio = static_cast<double>(prior.inliers) / static_cast<double>(points.size());
+  return prior;
 }
 
 }  // namespace cvo

@@ -57,7 +57,7 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   settings_ = settings;
   rgbd_builder_ = std::move(rgbd);
   stereo_builder_ = std::move(stereo);
-  tracker_ = std::move(tracker);  // its keyframe's corners are reseeded at the next keyframe
+  tracker_ = std::move(tracker);  // the next frame only takes its corners
   if (new_backend) {
     odometry_ = std::move(odometry);
     reset(start_pose_);
@@ -71,7 +71,7 @@ void OdometryPipeline::reset(const Eigen::Isometry3d& base_pose) {
   start_pose_ = base_pose;
   odometry_->reset(base_pose);
   tracker_->reset();
-  prior_pose_ = prior_keyframe_pose_ = prior_step_ = Eigen::Isometry3d::Identity();
+  prior_pose_ = prior_step_ = Eigen::Isometry3d::Identity();
   stale_.reset();
   stale_burst_ = false;
 }
@@ -96,18 +96,12 @@ std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFra
 }
 
 void OdometryPipeline::advancePriorPose(PipelineResult& result) {
-  const OdometryUpdate& update = result.update;
-  if (update.firstFrame() || !result.prior) {
-    if (!update.firstFrame()) prior_pose_ = prior_pose_ * prior_step_;  // no prior: keep going
-  } else {
-    const Eigen::Isometry3d pose = result.prior->solved
-                                       ? prior_keyframe_pose_ * result.prior->motion
-                                       : prior_pose_ * prior_step_;
-    prior_step_ = prior_pose_.inverse() * pose;
-    prior_pose_ = pose;
+  if (!result.update.firstFrame()) {
+    // Its own motions chained; constant velocity where it found none.
+    if (result.prior && result.prior->solved) prior_step_ = result.prior->motion;
+    prior_pose_ = prior_pose_ * prior_step_;
   }
   result.prior_pose = prior_pose_;
-  if (update.new_keyframe) prior_keyframe_pose_ = prior_pose_;
 }
 
 PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
@@ -151,9 +145,13 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     return result;
   }
   stale_.accept();
-  if (settings_.features.enabled && tracker_->seeded() && !images.grey.empty()) {
-    input.prior = tracker_->track(images.grey, intrinsics);
-    result.prior = input.prior;
+  if (!settings_.features.enabled || images.grey.empty()) {
+    tracker_->reset();  // the prior relates this frame and the next only: none without images
+  } else {
+    const bool tracked = tracker_->seeded();
+    MotionPrior prior =
+        tracker_->track(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
+    if (tracked) input.prior = result.prior = std::move(prior);
   }
   result.cloud = input.cloud;
   result.reference = odometry_->referenceCloud();
@@ -163,12 +161,6 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     result.outcome = FrameOutcome::kSkipped;
     result.why = std::string("registration rejected the frame: ") + e.what();
     return result;
-  }
-  if (result.update.state == TrackingState::kReset || result.update.firstFrame()) {
-    tracker_->reset();  // a new trajectory: the corners are the new keyframe's
-  }
-  if (settings_.features.enabled && result.update.new_keyframe && !images.grey.empty()) {
-    tracker_->seed(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
   }
   advancePriorPose(result);
   result.total_ms = millisecondsSince(start);

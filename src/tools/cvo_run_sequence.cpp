@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
       const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options, &trusted);
       cvo::printEvaluationReport(std::cout, report, options);
       if (prior_trajectory.size() >= 2) {
-        std::cout << "feature prior alone (KLT + PnP over the same keyframes), for comparison:\n";
+        std::cout << "feature prior alone (KLT + PnP frame to frame), for comparison:\n";
         cvo::printEvaluationReport(
             std::cout, cvo::evaluateTrajectory(ground_truth, prior_trajectory, options), options);
       }

@@ -51,8 +51,9 @@ TEST(OdometrySettings, ShippedPresetsLoadByNameAndByFile) {
 }
 
 TEST(OdometrySettings, PresetsStateOnlyWhatTheyChange) {
-  for (const auto& [name, text] : cvo::builtInPresets()) {
-    std::istringstream in(text);
+  for (const auto& preset : cvo::builtInPresets()) {
+    const std::string& name = preset.first;
+    std::istringstream in(preset.second);
     cvo::parseKeyValueLines(in, name, [&](const std::string& key, const std::string& value) {
       cvo::OdometrySettings changed;
       cvo::setSetting(changed, key, value);

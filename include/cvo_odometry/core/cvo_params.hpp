@@ -115,15 +115,13 @@ struct CvoParams {
   // The motion guess and the feature tracks' check (README "Fast motion").
   InitialGuess initial_guess = InitialGuess::kAuto;
   bool forget_motion = false;  // no constant-velocity guess: as after a restart (tests, bench)
-  int min_prior_inliers = 30;
-  double min_prior_inlier_ratio = 0.5;
+  int min_prior_inliers = 20;
+  double min_prior_inlier_ratio = 0.3;
   double guess_disagreement_translation = 0.05;  // m
   double guess_disagreement_rotation = 2.0;      // deg
   // A confident prior (min_prior_inliers, min_prior_inlier_ratio) judges every registration:
-  // at least min_track_agreement of its inliers within track_agreement_px plus
-  // track_agreement_ratio times their image motion (motion_prior.hpp: trackAgreement).
-  double track_agreement_px = 5.0;
-  double track_agreement_ratio = 0.5;
+  // at least min_track_agreement of its inliers within track_agreement_px.
+  double track_agreement_px = 10.0;
   double min_track_agreement = 0.5;
   // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.
   double tracked_cosine_ratio = 0.25;

@@ -151,9 +151,6 @@ void visitSettings(CvoParams& p, V&& v) {
                 "a feature track agrees with a registration within this reprojection error (px)",
                 0.1, 100.0},
     p.track_agreement_px);
-  v(SettingInfo{"track_agreement_ratio", "tracking",
-                "... plus this fraction of the track's image motion since the keyframe", 0.0, 0.99},
-    p.track_agreement_ratio);
   v(
       SettingInfo{
           "min_track_agreement", "tracking",

@@ -2,13 +2,13 @@
 // keyframe, or the previous good frame), judged (tracking_check.hpp), and chained into a pose
 // with its covariance on SE(3) (pose_covariance.hpp) in the camera and the base frame.
 //
-// Guesses (CvoParams::initial_guess): the feature prior (keyframe <- current from tracked
-// corners, when confident), constant velocity (the last good motion rate from the previous
-// frame's pose), or none (the previous frame's pose, at the first-frame lengthscale). In auto,
-// a confident prior is used; when it and constant velocity disagree by more than a bound both
-// are tried and the better registration kept. A bad registration is retried from the guess not
-// yet tried (prior, then none); if that fails too the frame is lost and
-// CvoParams::lost_frame_policy says what its pose is. A registration is good only when it
+// Guesses (CvoParams::initial_guess): the feature prior (previous <- current from tracked
+// corners, when confident, applied to the previous frame's pose), constant velocity (the last good
+// motion rate from the previous frame's pose), or none (the previous frame's pose, at the
+// first-frame lengthscale). In auto, a confident prior is used; when it and constant velocity
+// disagree by more than a bound both are tried and the better registration kept. A bad registration
+// is retried from the guess not yet tried (prior, then none); if that fails too the frame is lost
+// and CvoParams::lost_frame_policy says what its pose is. A registration is good only when it
 // converged, its cosine and speed are plausible and, with enough inlier tracks to judge, the
 // tracks agree with it.
 #pragma once
@@ -44,7 +44,7 @@ struct OdometryFrame {
   double stamp = 0.0;
   std::shared_ptr<const LabeledCloud> cloud;  // null: the front end found nothing to track
   std::string why_no_cloud;
-  std::optional<MotionPrior> prior;  // keyframe <- current from feature tracks
+  std::optional<MotionPrior> prior;  // previous frame <- current from feature tracks
   // base <- camera; taken at the first frame of a trajectory (after a reset).
   Eigen::Isometry3d base_from_camera = Eigen::Isometry3d::Identity();
 };
@@ -69,7 +69,7 @@ struct OdometryUpdate {
   GuessKind guess = GuessKind::kNone;  // of the registration used
   double track_agreement = -1.0;       // of the registration used; -1: not judged
   double track_error_px = -1.0;        // its median reprojection error of the prior's inliers
-  double track_flow_px = -1.0;         // their median image motion since the keyframe
+  double track_flow_px = -1.0;         // their median image motion over the step
   // In the base frame (REP-105: odom <- base_link), base = base_from_camera of the trajectory.
   Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d base_frame_motion = Eigen::Isometry3d::Identity();  // previous <- current
@@ -175,6 +175,7 @@ class KeyframeOdometry {
   Eigen::Isometry3d last_trusted_pose_ = Eigen::Isometry3d::Identity();
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;
+  bool previous_placed_by_prior_ = false;  // the last lost frame's pose came from the prior
   bool started_ = false;
   Eigen::Isometry3d base_from_camera_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d start_base_pose_ = Eigen::Isometry3d::Identity();

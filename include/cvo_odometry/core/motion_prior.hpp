@@ -1,6 +1,6 @@
 // A motion estimate independent of CVO, from feature tracks (the front end's FeatureTracker):
-// the keyframe's corners tracked into the current image and the motion solved from them. The
-// odometry starts CVO from it and checks CVO's result against its inlier tracks.
+// the previous frame's corners tracked into the current image and the motion solved from them.
+// The odometry starts CVO from it and checks CVO's result against its inlier tracks.
 #pragma once
 
 #include <string>
@@ -13,32 +13,28 @@ namespace cvo {
 
 struct MotionPrior {
   bool solved = false;  // a motion was found (see problem otherwise)
-  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // keyframe <- current (camera)
-  int tracks = 0;   // keyframe corners with depth tracked into the current image
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current (camera)
+  int tracks = 0;   // previous frame corners with depth tracked into the current image
   int inliers = 0;  // tracks consistent with `motion`
   double inlier_ratio = 0.0;
-  // The inlier tracks: keyframe points (camera frame) and where the current image sees them
-  // (normalised, undistorted image coordinates x/z, y/z).
+  // The inlier tracks: the previous frame's points (its camera frame) and where the current
+  // image sees them (normalised, undistorted image coordinates x/z, y/z).
   std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> points;
   std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>> observations;
-  double focal_px = 0.0;        // pixels per normalised unit: converts errors to pixels
-  bool wants_keyframe = false;  // few tracks are left: a new keyframe would restore them
-  std::string problem;          // why no motion was solved
+  double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
+  std::string problem;    // why no motion was solved
   double time_ms = 0.0;
 };
 
-// How well `motion` (keyframe <- current) explains the prior's inlier tracks: the fraction it
-// reprojects within `max_error_px` plus `flow_ratio` times the track's own image motion since
-// the keyframe of where the current image sees it, and the median error (px); -1 without
-// tracks. The flow term keeps a constant lag between the tracks' image and the geometry's
-// depth (an RGB-D camera's) from failing good registrations, while one stuck near the
-// keyframe's pose is off by a whole flow and fails.
+// How well `motion` (previous <- current) explains the prior's inlier tracks: the fraction it
+// reprojects within `max_error_px` of where the current image sees them, the median error and
+// the tracks' median image motion (px); -1 without tracks.
 struct TrackAgreement {
   double fraction = -1.0;
   double median_px = -1.0;
-  double median_flow_px = -1.0;  // how far the tracks moved in the image since the keyframe
+  double median_flow_px = -1.0;  // how far the tracks moved in the image over the step
 };
 TrackAgreement trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d& motion,
-                              double max_error_px, double flow_ratio);
+                              double max_error_px);
 
 }  // namespace cvo

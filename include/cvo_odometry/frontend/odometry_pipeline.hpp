@@ -44,8 +44,8 @@ struct PipelineResult {
   std::shared_ptr<const LabeledCloud> cloud;      // the frame's cloud, when it had one
   std::shared_ptr<const LabeledCloud> reference;  // what it was registered to, if anything
   std::optional<MotionPrior> prior;               // the feature prior, when it ran
-  // The feature prior's own odometry (start <- current, camera): its motions chained over the
-  // keyframes, constant velocity where it found none. A peer to compare with, never published.
+  // The feature prior's own odometry (start <- current, camera): its frame-to-frame motions
+  // chained, constant velocity where it found none. A peer to compare with, never published.
   std::optional<Eigen::Isometry3d> prior_pose;
   double total_ms = 0.0;
 };
@@ -81,7 +81,7 @@ class OdometryPipeline {
   // throws std::invalid_argument.
   std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
                                                  FrameImages* images);
-  // The prior's own pose for this frame, and its keyframe when the odometry took a new one.
+  // The prior's own pose for this frame.
   void advancePriorPose(PipelineResult& result);
   std::string staleness(const CameraFrame& frame);
 
@@ -94,7 +94,6 @@ class OdometryPipeline {
   std::unique_ptr<FeatureTracker> tracker_;
   StaleFrameDetector stale_;
   Eigen::Isometry3d prior_pose_ = Eigen::Isometry3d::Identity();  // of the last frame
-  Eigen::Isometry3d prior_keyframe_pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d prior_step_ = Eigen::Isometry3d::Identity();  // last frame to frame
   bool stale_burst_ = false;
   Eigen::Isometry3d start_pose_ = Eigen::Isometry3d::Identity();

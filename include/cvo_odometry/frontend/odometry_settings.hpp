@@ -64,10 +64,10 @@ void visitSettings(OdometrySettings& s, V&& v) {
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
   v(SettingInfo{"feature_prior", "features",
-                "track the keyframe's corners (KLT + PnP): a motion guess and a check "
+                "track the previous frame's corners (KLT + PnP): a motion guess and a check "
                 "independent of CVO"},
     s.features.enabled);
-  v(SettingInfo{"feature_corners", "features", "most corners seeded per keyframe", 8, 10000},
+  v(SettingInfo{"feature_corners", "features", "most corners taken per frame", 8, 10000},
     s.features.max_corners);
   v(SettingInfo{"feature_min_distance", "features", "least distance between corners (px)", 1.0,
                 200.0},
@@ -80,10 +80,6 @@ void visitSettings(OdometrySettings& s, V&& v) {
     s.features.max_flow_error);
   v(SettingInfo{"pnp_ransac_px", "features", "PnP inlier threshold (px)", 0.1, 50.0},
     s.features.ransac_px);
-  v(SettingInfo{"feature_reseed_fraction", "features",
-                "a new keyframe when fewer than this fraction of its corners are still tracked",
-                0.0, 1.0},
-    s.features.reseed_fraction);
 }
 
 // Defaults, then the preset at `path` (empty: none), validated; FormatError names the file and
