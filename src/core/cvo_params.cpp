@@ -90,6 +90,8 @@ std::string toString(BackendChoice backend) {
       return "cpu";
     case BackendChoice::kCuda:
       return "cuda";
+    case BackendChoice::kDeviceCpu:
+      return "device_cpu";
     default:
       return "auto";
   }
@@ -124,7 +126,8 @@ BackendChoice parseBackendChoice(const std::string& name) {
   if (name == "auto") return BackendChoice::kAuto;
   if (name == "cpu") return BackendChoice::kCpu;
   if (name == "cuda") return BackendChoice::kCuda;
-  throw std::invalid_argument("unknown backend '" + name + "' (auto, cpu or cuda)");
+  if (name == "device_cpu") return BackendChoice::kDeviceCpu;
+  throw std::invalid_argument("unknown backend '" + name + "' (auto, cpu, cuda or device_cpu)");
 }
 
 int resolvedThreadCount(int num_threads) {

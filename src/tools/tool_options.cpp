@@ -16,7 +16,7 @@ namespace cvo {
 const char* const kSharedOptionsUsage =
     "  --preset FILE           CVO parameters (config/tum_rgbd.yaml, config/kitti_stereo.yaml)\n"
     "  --set k=v[,k=v...]      override parameters of the preset\n"
-    "  --backend auto|cpu|cuda\n"
+    "  --backend auto|cpu|cuda|device_cpu\n"
     "  --tum DIR               TUM RGB-D folder (associations.txt or rgb.txt + depth.txt)\n"
     "    --camera NAME         fr1 | fr2 | fr3 | fx,fy,cx,cy[,k1,k2,p1,p2,k3] (fr1)\n"
     "    --depth-scale N       depth PNG units per metre (5000)\n"

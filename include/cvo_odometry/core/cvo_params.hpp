@@ -11,7 +11,8 @@ enum class StepMethod {
   kProcrustes  // default: closed-form weighted Procrustes (MM) step, coarse-to-fine lengthscales
 };
 
-enum class BackendChoice { kAuto, kCpu, kCuda };
+// kDeviceCpu: the CUDA backend's device code on OpenMP threads (tests it without a GPU).
+enum class BackendChoice { kAuto, kCpu, kCuda, kDeviceCpu };
 
 // What frame-to-frame odometry does with a frame it judges lost (see FrameToFrameOdometry).
 enum class LostFramePolicy {
