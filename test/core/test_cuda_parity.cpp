@@ -504,7 +504,9 @@ TEST(DeviceCpu, SameBitsOnAnyThreadCount) {
   const LabeledCloud target = cvo::readCloud(tumFile("frame10_3000"));
   const LabeledCloud source = cvo::readCloud(tumFile("frame11_3000"));
   cvo::RegistrationResult first;
-  for (int threads : {1, 2, 3, 7}) {
+  // Not 7: LLVM 14's libomp leaks a thread team when 7 threads follow fewer (LeakSanitizer;
+  // reproduced without Thrust).
+  for (int threads : {1, 2, 3, 4}) {
     cvo::CvoRegistration registration(params, std::make_unique<cvo::DeviceCpuBackend>(threads));
     const auto result = registration.align(target, source, Eigen::Isometry3d::Identity());
     if (threads == 1) {
