@@ -65,7 +65,11 @@ int main(int argc, char** argv) {
     std::string why_not;
     const bool cuda = cvo::cudaBackendAvailable(&why_not);
     if (cli.has("check-cuda")) {
-      std::cout << (cuda ? "CUDA device usable" : "no CUDA device: " + why_not) << "\n";
+      const bool says_so = why_not.rfind("no CUDA device", 0) == 0;
+      std::cout << (cuda      ? "CUDA device usable"
+                    : says_so ? why_not
+                              : "no CUDA device: " + why_not)
+                << "\n";
       return cuda ? 0 : 3;
     }
     const std::string data = cli.require("data");

@@ -85,9 +85,7 @@ class DeviceTest : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     std::string why_not;
-    if (GetParam() == "cuda" && !cvo::cudaBackendAvailable(&why_not)) {
-      GTEST_SKIP() << "no CUDA device: " << why_not;
-    }
+    if (GetParam() == "cuda" && !cvo::cudaBackendAvailable(&why_not)) GTEST_SKIP() << why_not;
   }
   std::unique_ptr<cvo::RegistrationBackend> device(int threads = 0) const {
     return makeDevice(GetParam(), threads);
@@ -199,7 +197,7 @@ class RegistrationParity : public ::testing::TestWithParam<DeviceAndCase> {
   void SetUp() override {
     std::string why_not;
     if (std::get<0>(GetParam()) == "cuda" && !cvo::cudaBackendAvailable(&why_not)) {
-      GTEST_SKIP() << "no CUDA device: " << why_not;
+      GTEST_SKIP() << why_not;
     }
   }
 };
