@@ -102,60 +102,59 @@ struct PairContext {
     });
   }
 
-  // Source point j's moment sums over its candidates.
-  CVO_HOST_DEVICE kernels::PointSums pointSums(int j, const float* z) const {
+  // Adds source point j's (at z) share of the moments over its candidates to m.
+  CVO_HOST_DEVICE void addMoments(int j, const float* z, kernels::MomentSums& m) const {
     kernels::PointSums sums;
     kernels::clear(sums);
     forEachPair(j, z, [&](const float* x, float a) {
       kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
     });
+    if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
+  }
+};
+
+// Source point j's share of an evaluation's sums: the point moved by the pose, then
+// add(context, j, z, sums) over its candidates.
+template <class Sums, class Add>
+struct ShareOfPoint {
+  PairContext c;
+  Add add;
+  CVO_HOST_DEVICE Sums operator()(int j) const {
+    Sums sums;
+    kernels::clear(sums);
+    float z[3];
+    c.moved(j, z);
+    add(c, j, z, sums);
     return sums;
   }
 };
 
-// Per source point j: its share of each evaluation's sums.
-struct MomentsOfPoint {
-  PairContext c;
-  CVO_HOST_DEVICE kernels::MomentSums operator()(int j) const {
-    kernels::MomentSums m;
-    kernels::clear(m);
-    float z[3];
-    c.moved(j, z);
-    const kernels::PointSums sums = c.pointSums(j, z);
-    if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
-    return m;
+struct AddMoments {
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::MomentSums& m) const {
+    c.addMoments(j, z, m);
   }
 };
 
-struct TaylorOfPoint {
-  PairContext c;
+struct AddTaylor {
   Twist xi;
-  CVO_HOST_DEVICE kernels::TaylorSums operator()(int j) const {
-    kernels::TaylorSums s;
-    kernels::clear(s);
-    float z[3];
-    c.moved(j, z);
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::TaylorSums& s) const {
     kernels::TaylorFrame frame;
     kernels::makeTaylorFrame(z, xi.v, frame);
     c.forEachPair(j, z, [&](const float* x, float a) {
       if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, c.inv_ell2);
     });
-    return s;
   }
 };
 
 // Moments over every source point, the Hessian from every kCurvatureStride-th (as the CPU).
-struct CurvatureOfPoint {
-  PairContext c;
-  CVO_HOST_DEVICE kernels::CurvatureSums operator()(int j) const {
-    kernels::CurvatureSums out;
-    kernels::clear(out);
-    float z[3];
-    c.moved(j, z);
+struct AddCurvature {
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::CurvatureSums& out) const {
     if (j % kernels::kCurvatureStride != 0) {
-      const kernels::PointSums sums = c.pointSums(j, z);
-      if (sums.pairs > 0) kernels::accumulatePoint(out.moments, sums, z);
-      return out;
+      c.addMoments(j, z, out.moments);
+      return;
     }
     kernels::PointCurvature sums;
     kernels::clear(sums);
@@ -165,7 +164,6 @@ struct CurvatureOfPoint {
                                        inv_shell_width);
     });
     kernels::accumulatePointCurvature(out, sums, z, c.inv_ell2, kernels::kCurvatureStride);
-    return out;
   }
 };
 
@@ -302,13 +300,15 @@ struct DevicePairSums<System>::Impl {
     return c;
   }
 
-  // One transform_reduce over the source points (one wait, for the result).
-  template <class Sums, class PerPoint>
-  Sums sumOverSource(const PerPoint& per_point) {
+  // One transform_reduce over the source points, `add` giving each point's share at (pose,
+  // ell); one wait, for the result.
+  template <class Sums, class Add>
+  Sums sumOverSource(const float* pose, double ell, const Add& add) {
     Sums zero;
     kernels::clear(zero);
     const thrust::counting_iterator<int> points(0);
-    return thrust::transform_reduce(runtime.policy(), points, points + count[1], per_point, zero,
+    return thrust::transform_reduce(runtime.policy(), points, points + count[1],
+                                    ShareOfPoint<Sums, Add>{context(pose, ell), add}, zero,
                                     AddSums<Sums>{});
   }
 };
@@ -358,8 +358,7 @@ void DevicePairSums<System>::setConstants(const kernels::KernelConstants& consta
 template <DeviceSystem System>
 kernels::MomentSums DevicePairSums<System>::moments(const float* pose, double ell) {
   return guarded("moments", [&] {
-    return impl_->template sumOverSource<kernels::MomentSums>(
-        MomentsOfPoint{impl_->context(pose, ell)});
+    return impl_->template sumOverSource<kernels::MomentSums>(pose, ell, AddMoments{});
   });
 }
 
@@ -367,17 +366,16 @@ template <DeviceSystem System>
 kernels::TaylorSums DevicePairSums<System>::taylor(const float* pose, const double* xi,
                                                    double ell) {
   return guarded("taylor", [&] {
-    TaylorOfPoint per_point{impl_->context(pose, ell), {}};
-    std::copy(xi, xi + 6, per_point.xi.v);
-    return impl_->template sumOverSource<kernels::TaylorSums>(per_point);
+    AddTaylor add;
+    std::copy(xi, xi + 6, add.xi.v);
+    return impl_->template sumOverSource<kernels::TaylorSums>(pose, ell, add);
   });
 }
 
 template <DeviceSystem System>
 kernels::CurvatureSums DevicePairSums<System>::curvature(const float* pose, double ell) {
   return guarded("curvature", [&] {
-    return impl_->template sumOverSource<kernels::CurvatureSums>(
-        CurvatureOfPoint{impl_->context(pose, ell)});
+    return impl_->template sumOverSource<kernels::CurvatureSums>(pose, ell, AddCurvature{});
   });
 }
 
