@@ -1,5 +1,6 @@
 #include "cvo_odometry/frontend/stereo_matcher.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -44,10 +45,15 @@ cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right) cons
                                 std::to_string(left.rows) + " but right is " +
                                 std::to_string(right.cols) + "x" + std::to_string(right.rows));
   }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // No pixel of an image narrower than the disparity range can be matched (and OpenCV 4.6's
+  // sgbm_3way then sizes its buffers negative: found by fuzz_frontend).
+  const int usable = left.cols + std::min(options_.min_disparity, 0) -
+                     std::max(options_.min_disparity + options_.num_disparities, 0);
+  if (usable <= 0) return cv::Mat(left.size(), CV_32FC1, cv::Scalar(nan));
   cv::Mat fixed_point;  // CV_16S, disparity * 16
   sgbm_->compute(toGrey(left), toGrey(right), fixed_point);
   cv::Mat pixels(fixed_point.size(), CV_32FC1);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   const int invalid_below = options_.min_disparity * 16;  // SGBM marks failures with min - 1
   for (int v = 0; v < fixed_point.rows; ++v) {
     const auto* in = fixed_point.ptr<std::int16_t>(v);

@@ -68,6 +68,24 @@ TEST(StereoMatcher, AgreesWithThirdPartyDisparityOnTheKittiPair) {
   EXPECT_GT(fraction, 0.90);
 }
 
+// An image no wider than the disparity range has no pixel to match (fuzz_frontend's find:
+// OpenCV's sgbm_3way sized its buffers negative): all NaN, in every mode.
+TEST(StereoMatcher, ImageNarrowerThanTheDisparityRangeGivesNoDisparity) {
+  for (const char* mode : {"sgbm_3way", "sgbm", "hh"}) {
+    for (int cols : {1, 11, 16}) {
+      cvo::StereoMatcherOptions options;
+      options.num_disparities = 16;
+      options.mode = mode;
+      cv::Mat left(32, cols, CV_8UC1), right(32, cols, CV_8UC1);
+      cv::randu(left, 0, 255);
+      cv::randu(right, 0, 255);
+      const cv::Mat disparity = cvo::StereoMatcher(options).disparity(left, right);
+      ASSERT_EQ(disparity.size(), left.size()) << mode;
+      EXPECT_EQ(cv::countNonZero(disparity == disparity), 0) << mode << ", " << cols << " columns";
+    }
+  }
+}
+
 TEST(StereoFrontend, GivenDisparityGivesMetricDepthCroppedAndInRange) {
   const cv::Mat left = readGrey(kPair + "/left.png");
   const cv::Mat disparity = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
