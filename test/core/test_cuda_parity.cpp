@@ -1,10 +1,11 @@
 // The device backends against the CPU backend. Every case runs on `device_cpu` (the device code,
 // the same Thrust source as the CUDA backend's, on OpenMP threads) in every build that has it,
 // CI's included, never skipped; and on `cuda` where a device is present (skipped with a message
-// elsewhere). Registrations agree within 1e-4 rad / 0.1 mm, the indicator within 1e-5 relative
-// and the iterations within 1, on synthetic rooms and real TUM frames, colour and geometric, both
-// step methods; the sums themselves agree; edge cases of the grid (empty, one point, growing
-// and shrinking clouds, a huge bounding box) and a device error (the CPU takes over).
+// elsewhere). On synthetic rooms and real TUM frames, colour and geometric: free-running
+// registrations (procrustes) agree within 1e-4 rad / 0.1 mm, the indicator within 1e-5 relative
+// and the iterations within 1; in lockstep (both step methods, semantics) every evaluation's
+// sums agree within 1e-5; the sums themselves agree; edge cases of the grid (empty, one point,
+// growing and shrinking clouds, a huge bounding box); a device error (the CPU takes over).
 #include <gtest/gtest.h>
 
 #include <cmath>
