@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cvo_odometry needs; quick and quiet when they are all present.
 # Usage: scripts/install_deps.sh [core|full|peers|viz|sanitize]
-#   core: CMake, compiler, Eigen, GoogleTest; full: + OpenCV and ROS; peers: + PCL, Open3D,
+#   core: CMake, compiler, Eigen, GoogleTest, Thrust (device_cpu); full: + OpenCV and ROS; peers: + PCL, Open3D,
 #   OpenCV contrib; viz: full + rviz; sanitize: core + OpenCV + clang and its runtimes
 set -euo pipefail
 profile=${1:-full}
 
-core=(cmake g++ make libeigen3-dev libgtest-dev)
+# libthrust-dev (with libcub-dev): the device code on CPU threads (device_cpu) without CUDA.
+core=(cmake g++ make libeigen3-dev libgtest-dev libthrust-dev libcub-dev)
 full=("${core[@]}" libopencv-dev clang-format
   catkin ros-message-generation ros-message-runtime ros-std-msgs libroscpp-dev libstd-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libnodeletlib-dev libnodelet-dev
@@ -19,8 +20,9 @@ full=("${core[@]}" libopencv-dev clang-format
   libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev)
 # rviz only for watching (scripts/demo.sh --rviz): large, not needed by the tests.
 viz=("${full[@]}" rviz)
-# The checking build (scripts/test_sanitizers.sh): clang with its sanitizer and libFuzzer runtimes.
-sanitize=("${core[@]}" libopencv-dev clang libclang-rt-14-dev)
+# The checking build (scripts/test_sanitizers.sh): clang with its sanitizer and libFuzzer runtimes
+# and its OpenMP (libomp: the CPU backend's threads and device_cpu).
+sanitize=("${core[@]}" libopencv-dev clang libclang-rt-14-dev libomp-14-dev)
 # Peers for bench/peer_table.sh only (large: PCL, Open3D, OpenCV contrib).
 peers=(libopencv-contrib-dev libpcl-dev python3-open3d python3-numpy)
 

@@ -8,7 +8,8 @@ set -euo pipefail
 source "$(dirname "$0")/env.sh"
 cvo_configure
 cmake --build "$CVO_BUILD" -j"$(cvo_jobs)" --target all tests
-(cd "$CVO_BUILD" && ctest --output-on-failure -j"$(cvo_jobs)")
+(cd "$CVO_BUILD" && ctest --output-on-failure -j"$(cvo_jobs)") | tee "$CVO_BUILD/ctest.log"
+cvo_parity_summary "$CVO_BUILD/ctest.log"
 if [ "${CVO_SKIP_SANITIZERS:-0}" != 1 ]; then
   "$CVO_ROOT/scripts/test_sanitizers.sh"
 fi

@@ -4,8 +4,8 @@
 
 #include "cvo_odometry/core/cpu_backend.hpp"
 #include "cvo_odometry/core/failover_backend.hpp"
-#ifdef CVO_HAVE_CUDA
-#include "cvo_odometry/core/cuda_backend.hpp"
+#if defined(CVO_HAVE_CUDA) || defined(CVO_HAVE_DEVICE_CPU)
+#include "cvo_odometry/core/device_backend.hpp"
 #endif
 
 namespace cvo {
@@ -23,6 +23,15 @@ bool cudaBackendAvailable(std::string* why_not) {
 std::unique_ptr<RegistrationBackend> makeBackend(BackendChoice choice, int num_threads,
                                                  std::string* why_cpu) {
   if (why_cpu) why_cpu->clear();
+  if (choice == BackendChoice::kDeviceCpu) {
+    // For tests: no fallback, so that a failure of the device code shows.
+#ifdef CVO_HAVE_DEVICE_CPU
+    return std::make_unique<DeviceCpuBackend>(num_threads);
+#else
+    throw std::runtime_error(
+        "backend device_cpu: this build has none (it needs Thrust's headers and OpenMP)");
+#endif
+  }
   if (choice != BackendChoice::kCpu) {
     std::string why_not;
     if (cudaBackendAvailable(&why_not)) {

@@ -102,7 +102,10 @@ const std::vector<EnumName<StepMethod>>& enumNames(StepMethod) {
 
 const std::vector<EnumName<BackendChoice>>& enumNames(BackendChoice) {
   static const std::vector<EnumName<BackendChoice>> names{
-      {BackendChoice::kAuto, "auto"}, {BackendChoice::kCpu, "cpu"}, {BackendChoice::kCuda, "cuda"}};
+      {BackendChoice::kAuto, "auto"},
+      {BackendChoice::kCpu, "cpu"},
+      {BackendChoice::kCuda, "cuda"},
+      {BackendChoice::kDeviceCpu, "device_cpu"}};
   return names;
 }
 

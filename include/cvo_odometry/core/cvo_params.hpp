@@ -14,7 +14,8 @@ enum class StepMethod {
   kProcrustes  // default: closed-form weighted Procrustes (MM) step, coarse-to-fine lengthscales
 };
 
-enum class BackendChoice { kAuto, kCpu, kCuda };
+// kDeviceCpu: the CUDA backend's device code on OpenMP threads (tests it without a GPU).
+enum class BackendChoice { kAuto, kCpu, kCuda, kDeviceCpu };
 
 // What a frame is registered to: the keyframe (changed when overlap or distance demand it) or
 // the previous good frame.

@@ -1,9 +1,11 @@
-// The CUDA side of the CUDA backend, with a plain interface (no Eigen, no CUDA types) so that
-// only src/core/cuda/device_pair_sums.cu needs nvcc. Device buffers persist and grow; clouds are
-// uploaded through pinned staging memory; the target's neighbour grid (dense_grid.hpp, shared
-// with the CPU) is built on the GPU by a stable radix sort of the cell indices, without a host
-// wait; an evaluation sums on the device and waits once, for its result.
-// Every call throws std::runtime_error naming the failing CUDA call.
+// The device side of the device backends, with a plain interface (no Eigen, no Thrust or CUDA
+// types). One Thrust source (src/core/cuda/device_pair_sums.cu) is built twice: by nvcc for a
+// CUDA GPU (DeviceSystem::kCuda, the `cuda` backend) and by the host compiler for OpenMP threads
+// (DeviceSystem::kOmp, the `device_cpu` backend, which runs the GPU's code where there is no GPU).
+// Device vectors persist and grow; the target's neighbour grid (dense_grid.hpp, shared with the
+// CPU) is built on the device (cell of each point, stable sort, cell ranges by binary search);
+// each evaluation is one transform_reduce over the source points, deterministic run to run.
+// Every call throws std::runtime_error naming what failed (a CUDA error, device memory).
 #pragma once
 
 #include <memory>
@@ -13,9 +15,13 @@
 
 namespace cvo {
 
+enum class DeviceSystem { kCuda, kOmp };
+
+template <DeviceSystem System>
 class DevicePairSums {
  public:
-  DevicePairSums();
+  // `threads`: OpenMP threads of the reductions (kOmp; 0: OpenMP's default); unused on CUDA.
+  explicit DevicePairSums(int threads = 0);
   ~DevicePairSums();
   DevicePairSums(const DevicePairSums&) = delete;
   DevicePairSums& operator=(const DevicePairSums&) = delete;

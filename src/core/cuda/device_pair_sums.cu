@@ -1,10 +1,29 @@
-#include <cuda_runtime.h>
-
-#include <cub/device/device_radix_sort.cuh>
-#include <cub/device/device_scan.cuh>
+// The device path of the device backends, written once as Thrust algorithms over device vectors
+// and built twice: by nvcc for a CUDA GPU (the `cuda` backend) and by the host compiler with
+// THRUST_DEVICE_SYSTEM=THRUST_DEVICE_SYSTEM_OMP for OpenMP threads (device_pair_sums_omp.cpp, the
+// `device_cpu` backend), so that every CI run executes the code a GPU runs. The per-point work is
+// functors over the shared __host__ __device__ kernels (pair_kernels.hpp, dense_grid.hpp); what
+// differs by system (execution policy, staging, the OpenMP reduction) is in cuda_system.cuh and
+// omp_system.hpp.
+//
+// Determinism: the grid is a stable sort (a unique order); each evaluation is one
+// transform_reduce over the source points, whose order of additions is fixed for a given size:
+// on CUDA by CUB's reduction (run to run on a device), on OpenMP by fixed chunks added in order
+// (omp_system.hpp: the same bits for any thread count).
+#include <thrust/binary_search.h>
+#include <thrust/device_vector.h>
+#include <thrust/gather.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+#include <thrust/sequence.h>
+#include <thrust/sort.h>
+#include <thrust/system_error.h>
+#include <thrust/transform.h>
+#include <thrust/transform_reduce.h>
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,37 +31,19 @@
 #include "cvo_odometry/core/dense_grid.hpp"
 #include "cvo_odometry/core/device_pair_sums.hpp"
 
+#if THRUST_DEVICE_SYSTEM == THRUST_DEVICE_SYSTEM_CUDA
+#include "cuda_system.cuh"
+#elif THRUST_DEVICE_SYSTEM == THRUST_DEVICE_SYSTEM_OMP
+#include "omp_system.hpp"
+#else
+#error "device_pair_sums: THRUST_DEVICE_SYSTEM must be CUDA or OMP"
+#endif
+
 namespace cvo {
 
 namespace {
 
-constexpr int kThreads = 128;  // one source point a thread, one partial sum a block
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) {
-    throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-  }
-}
-
-// A device array that only grows.
-template <class T>
-struct DeviceBuffer {
-  T* data = nullptr;
-  std::size_t capacity = 0;
-  void reserve(std::size_t n) {
-    if (n <= capacity) return;
-    if (data) cudaFree(data);
-    data = nullptr;
-    capacity = 0;  // a failed allocation leaves an empty buffer, not a stale size
-    check(cudaMalloc(&data, std::max<std::size_t>(n, 1) * sizeof(T)), "cudaMalloc");
-    capacity = n;
-  }
-  ~DeviceBuffer() {
-    if (data) cudaFree(data);
-  }
-};
-
-// The pose and twist travel as kernel arguments: no copy, no host wait per evaluation.
+// The pose and twist travel inside the functors: no copy, no host wait per evaluation.
 struct Pose3x4 {
   float m[12];
 };
@@ -50,425 +51,334 @@ struct Twist {
   double v[6];
 };
 
-struct GridView {
-  kernels::DenseGridShape shape;
-  const unsigned int* start;  // cells + 1 offsets into the sorted target arrays
-  float radius;               // the query radius (<= the cell edge)
-};
-
 struct CloudView {
   const float* positions;
-  const float* colors;
-  const float* semantics;
-  int count;
+  const float* colors;     // unused without colour
+  const float* semantics;  // unused without semantics
 };
 
-// What one evaluation's kernel needs, copied into its device lambda.
-struct Evaluation {
-  int blocks;
-  Pose3x4 pose;
+// What every per-point functor reads: the target sorted by cell and its grid, the source, the
+// pose and the kernels at this lengthscale.
+struct PairContext {
   CloudView target, source;
-  GridView grid;
+  kernels::DenseGridShape shape;
+  const unsigned* start;  // first sorted point of every cell, then the point count
+  float radius;           // the query radius: the cut-off at this lengthscale (<= the cell edge)
+  float reach2;           // radius^2 and a margin: no pair beyond it can be retained
+  Pose3x4 pose;
   kernels::KernelConstants k;
   float inv_two_ell2;
   double inv_ell2;
-};
 
-// Visits the target points in the cell ranges the query ball around z reaches.
-template <class F>
-__device__ void forEachCandidate(const GridView& grid, const float* z, F&& f) {
-  kernels::forEachRangeWithin(grid.shape, grid.start, z, grid.radius,
-                              [&](unsigned int begin, unsigned int end) {
-                                for (unsigned int k = begin; k < end; ++k)
-                                  f(k);
-                              });
-}
-
-__device__ float pairAppearance(const kernels::KernelConstants& k, const CloudView& target, int i,
-                                const CloudView& source, int j) {
-  const float d2 = kernels::appearanceDistance2(
-      k, k.use_color ? target.colors + kernels::kColorDim * i : nullptr,
-      k.use_color ? source.colors + kernels::kColorDim * j : nullptr,
-      k.semantic_classes ? target.semantics + k.semantic_classes * i : nullptr,
-      k.semantic_classes ? source.semantics + k.semantic_classes * j : nullptr);
-  return kernels::appearanceWeight(k, d2);
-}
-
-// Block-wide sum into thread 0 in a fixed tree order (deterministic run to run).
-template <class Sums, class Add>
-__device__ void blockReduce(Sums* shared, Sums value, Add add) {
-  shared[threadIdx.x] = value;
-  __syncthreads();
-  for (int stride = blockDim.x / 2; stride > 0; stride /= 2) {
-    if (threadIdx.x < stride) add(shared[threadIdx.x], shared[threadIdx.x + stride]);
-    __syncthreads();
-  }
-}
-
-// Calls f(x, a) for every candidate target point x of source point j (at z), with the pair's
-// retained weight a (0 when not retained).
-template <class F>
-__device__ void forEachPairWeight(const CloudView& target, const CloudView& source,
-                                  const GridView& grid, const kernels::KernelConstants& k, int j,
-                                  const float* z, float inv_two_ell2, F&& f) {
-  forEachCandidate(grid, z, [&](unsigned int i) {
-    const float* x = target.positions + 3 * i;
-    f(x, kernels::retainedPairWeight(pairAppearance(k, target, i, source, j), x[0] - z[0],
-                                     x[1] - z[1], x[2] - z[2], inv_two_ell2, k.sp_thres));
-  });
-}
-
-// Source point j's moment sums over its candidates.
-__device__ kernels::PointSums pointSums(const CloudView& target, const CloudView& source,
-                                        const GridView& grid, const kernels::KernelConstants& k,
-                                        int j, const float* z, float inv_two_ell2) {
-  kernels::PointSums sums;
-  kernels::clear(sums);
-  forEachPairWeight(target, source, grid, k, j, z, inv_two_ell2, [&](const float* x, float a) {
-    kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
-  });
-  return sums;
-}
-
-// One thread a source point: per_point(j, T z_j, sums) adds the point's share to the thread's
-// sums; the block's sums are added in a fixed tree order, one partial a block.
-template <class Sums, class PerPoint>
-__global__ void sourcePointsKernel(CloudView source, Pose3x4 pose, PerPoint per_point,
-                                   Sums* partial) {
-  __shared__ Sums shared[kThreads];
-  const int j = blockIdx.x * blockDim.x + threadIdx.x;
-  Sums mine;
-  kernels::clear(mine);
-  if (j < source.count) {
-    float z[3];
+  // Source point j moved by the pose.
+  CVO_HOST_DEVICE void moved(int j, float* z) const {
     kernels::transformPoint(pose.m, source.positions + 3 * j, z);
-    per_point(j, z, mine);
-  }
-  blockReduce(shared, mine, [](Sums& a, const Sums& b) { kernels::add(a, b); });
-  if (threadIdx.x == 0) partial[blockIdx.x] = shared[0];
-}
-
-// Grid build: the cell of every target point and the points per cell.
-__global__ void cellKernel(const float* positions, int count, GridView grid, unsigned int* cell,
-                           unsigned int* counts) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= count) return;
-  cell[i] = static_cast<unsigned int>(kernels::cellOfPoint(grid.shape, positions + 3 * i));
-  atomicAdd(&counts[cell[i]], 1u);
-}
-
-// The per-block partial sums into one: thread t adds blocks t, t + kThreads, ... in order, then a
-// fixed tree (deterministic run to run).
-template <class Sums>
-__global__ void finalSumKernel(const Sums* partial, int blocks, Sums* total) {
-  __shared__ Sums shared[kThreads];
-  Sums mine;
-  kernels::clear(mine);
-  for (int b = threadIdx.x; b < blocks; b += blockDim.x)
-    kernels::add(mine, partial[b]);
-  blockReduce(shared, mine, [](Sums& a, const Sums& b) { kernels::add(a, b); });
-  if (threadIdx.x == 0) *total = shared[0];
-}
-
-__global__ void iotaKernel(unsigned int* values, int count) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < count) values[i] = static_cast<unsigned int>(i);
-}
-
-__global__ void gatherKernel(const unsigned int* order, int count, const float* positions,
-                             const float* colors, const float* semantics, int classes,
-                             float* out_positions, float* out_colors, float* out_semantics) {
-  const int k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= count) return;
-  const unsigned int i = order[k];
-  for (int a = 0; a < 3; ++a)
-    out_positions[3 * k + a] = positions[3 * i + a];
-  if (colors) {
-    for (int a = 0; a < kernels::kColorDim; ++a) {
-      out_colors[kernels::kColorDim * k + a] = colors[kernels::kColorDim * i + a];
-    }
-  }
-  for (int a = 0; a < classes; ++a)
-    out_semantics[classes * k + a] = semantics[classes * i + a];
-}
-
-}  // namespace
-
-struct DevicePairSums::Impl {
-  cudaStream_t stream = nullptr;
-  // Raw uploads and the target sorted by cell.
-  DeviceBuffer<float> raw[2][3];  // [target/source][positions, colors, semantics]
-  DeviceBuffer<float> sorted[3];  // target in cell order
-  DeviceBuffer<unsigned int> cell, sorted_cell, counts, start, iota, order;
-  DeviceBuffer<unsigned char> scratch;  // CUB's temporary storage
-  DeviceBuffer<kernels::MomentSums> moment_partials;
-  DeviceBuffer<kernels::TaylorSums> taylor_partials;
-  DeviceBuffer<kernels::MomentSums> moment_total;
-  DeviceBuffer<kernels::TaylorSums> taylor_total;
-  DeviceBuffer<kernels::CurvatureSums> curvature_partials, curvature_total;
-  float* pinned = nullptr;  // staging for uploads
-  std::size_t pinned_capacity = 0;
-  kernels::MomentSums* pinned_moments = nullptr;  // the one download of an evaluation
-  kernels::TaylorSums* pinned_taylor = nullptr;
-  kernels::CurvatureSums* pinned_curvature = nullptr;
-  int count[2] = {0, 0};
-  int classes = 0;
-  bool target_has_color = false;
-  std::vector<float> host_positions;  // target positions, for the bounding box
-  kernels::KernelConstants constants{};
-  double cutoff2 = 0.0;
-  double grid_cell = -1.0;
-  GridView grid{};
-
-  // Uploads the three arrays of a cloud through one pinned staging buffer and one wait.
-  void upload(int which, const float* const* data, const std::size_t* sizes) {
-    const std::size_t total = sizes[0] + sizes[1] + sizes[2];
-    if (total > pinned_capacity) {
-      if (pinned) cudaFreeHost(pinned);
-      pinned = nullptr;
-      pinned_capacity = 0;
-      check(cudaMallocHost(&pinned, total * sizeof(float)), "cudaMallocHost");
-      pinned_capacity = total;
-    }
-    std::size_t offset = 0;
-    for (int a = 0; a < 3; ++a) {
-      raw[which][a].reserve(sizes[a]);
-      if (sizes[a] == 0) continue;
-      std::copy(data[a], data[a] + sizes[a], pinned + offset);
-      check(cudaMemcpyAsync(raw[which][a].data, pinned + offset, sizes[a] * sizeof(float),
-                            cudaMemcpyHostToDevice, stream),
-            "upload");
-      offset += sizes[a];
-    }
-    check(cudaStreamSynchronize(stream), "upload sync");  // the staging buffer is reused
   }
 
-  // The target sorted by grid cell (a stable radix sort of the cell indices) and each cell's
-  // first point (an exclusive scan of the cell counts), all on the device, no host wait.
-  void buildGrid(double cell_size) {
-    const int n = count[0];
-    float lo[3], hi[3];
-    kernels::boundingBox(host_positions.data(), n, lo, hi);
-    // Coarsen the cells when the box is huge (outdoor): still exact, just more points scanned.
-    float edge = static_cast<float>(cell_size);
-    double cells = kernels::shapeOverBox(lo, hi, edge, &grid.shape);
-    while (cells > kernels::kMaxDenseCells) {
-      edge *= 1.5f;
-      cells = kernels::shapeOverBox(lo, hi, edge, &grid.shape);
-    }
-    const auto total = static_cast<std::size_t>(cells);
-    int cell_bits = 1;
-    while ((std::size_t{1} << cell_bits) < total)
-      ++cell_bits;
-    std::size_t scan_bytes = 0, sort_bytes = 0;
-    check(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, counts.data, start.data,
-                                        static_cast<int>(total + 1), stream),
-          "scan size");
-    check(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, cell.data, sorted_cell.data,
-                                          iota.data, order.data, n, 0, cell_bits, stream),
-          "sort size");
-    reserveGrid(n, total, std::max(scan_bytes, sort_bytes));
-    check(cudaMemsetAsync(counts.data, 0, (total + 1) * sizeof(unsigned int), stream), "memset");
-    if (n > 0) {
-      const int blocks = (n + kThreads - 1) / kThreads;
-      cellKernel<<<blocks, kThreads, 0, stream>>>(raw[0][0].data, n, grid, cell.data, counts.data);
-      iotaKernel<<<blocks, kThreads, 0, stream>>>(iota.data, n);
-      check(cudaGetLastError(), "cell kernels");
-    }
-    // counts[total] stays 0, so the scan gives start[c] = first point of cell c and
-    // start[total] = n.
-    scan_bytes = scratch.capacity;
-    check(cub::DeviceScan::ExclusiveSum(scratch.data, scan_bytes, counts.data, start.data,
-                                        static_cast<int>(total + 1), stream),
-          "scan");
-    if (n > 0) {
-      sort_bytes = scratch.capacity;
-      check(cub::DeviceRadixSort::SortPairs(scratch.data, sort_bytes, cell.data, sorted_cell.data,
-                                            iota.data, order.data, n, 0, cell_bits, stream),
-            "sort");
-      const int blocks = (n + kThreads - 1) / kThreads;
-      gatherKernel<<<blocks, kThreads, 0, stream>>>(
-          order.data, n, raw[0][0].data, target_has_color ? raw[0][1].data : nullptr,
-          raw[0][2].data, classes, sorted[0].data, sorted[1].data, sorted[2].data);
-      check(cudaGetLastError(), "gather kernel");
-    }
-    grid.start = start.data;
-    grid.radius = static_cast<float>(cell_size);
-    grid_cell = cell_size;
+  // f(x, a) for the candidate target points x of source point j (at z) that may be retained,
+  // with the pair's retained weight a (0 when not retained), in the grid's fixed order. The
+  // ranges also hold points beyond the ball (weight 0, which adds nothing to any sum): those are
+  // skipped before their appearance is computed.
+  template <class F>
+  CVO_HOST_DEVICE void forEachPair(int j, const float* z, F&& f) const {
+    const bool appearance = k.use_color || k.semantic_classes > 0;
+    kernels::forEachRangeWithin(shape, start, z, radius, [&](unsigned begin, unsigned end) {
+      for (unsigned i = begin; i < end; ++i) {
+        const float* x = target.positions + 3 * i;
+        const float dx = x[0] - z[0], dy = x[1] - z[1], dz = x[2] - z[2];
+        if (dx * dx + dy * dy + dz * dz > reach2) continue;
+        const float weight =
+            appearance
+                ? kernels::appearanceWeight(
+                      k,
+                      kernels::appearanceDistance2(
+                          k, k.use_color ? target.colors + kernels::kColorDim * i : nullptr,
+                          k.use_color ? source.colors + kernels::kColorDim * j : nullptr,
+                          k.semantic_classes ? target.semantics + k.semantic_classes * i : nullptr,
+                          k.semantic_classes ? source.semantics + k.semantic_classes * j : nullptr))
+                : k.max_weight;  // = appearanceWeight(k, 0)
+        f(x, kernels::retainedPairWeight(weight, dx, dy, dz, inv_two_ell2, k.sp_thres));
+      }
+    });
   }
 
-  void reserveGrid(int n, std::size_t total, std::size_t scratch_bytes) {
-    cell.reserve(n);
-    sorted_cell.reserve(n);
-    iota.reserve(n);
-    order.reserve(n);
-    counts.reserve(total + 1);
-    start.reserve(total + 1);
-    scratch.reserve(scratch_bytes);
-    sorted[0].reserve(3 * static_cast<std::size_t>(n));
-    sorted[1].reserve(kernels::kColorDim * static_cast<std::size_t>(n));
-    sorted[2].reserve(static_cast<std::size_t>(classes) * n);
-  }
-
-  // Grid for this lengthscale (rebuilt when it changed); returns the number of blocks, one
-  // source point a thread.
-  int prepare(double ell) {
-    const double radius = std::sqrt(cutoff2) * ell;
-    if (grid_cell != radius) buildGrid(radius);
-    return std::max(1, (count[1] + kThreads - 1) / kThreads);
-  }
-
-  // Adds the per-block partial sums on the device and waits for the one result.
-  template <class Sums>
-  Sums sumPartials(const DeviceBuffer<Sums>& partials, int blocks, DeviceBuffer<Sums>& total,
-                   Sums* pinned_total) {
-    total.reserve(1);
-    finalSumKernel<<<1, kThreads, 0, stream>>>(partials.data, blocks, total.data);
-    check(cudaGetLastError(), "sum kernel");
-    check(cudaMemcpyAsync(pinned_total, total.data, sizeof(Sums), cudaMemcpyDeviceToHost, stream),
-          "download sums");
-    check(cudaStreamSynchronize(stream), "sums sync");
-    return *pinned_total;
-  }
-
-  // The grid for `ell` and the kernel's inputs.
-  Evaluation evaluation(const float* pose, double ell) {
-    Evaluation e;
-    e.blocks = prepare(ell);
-    std::copy(pose, pose + 12, e.pose.m);
-    e.target = targetView();
-    e.source = sourceView();
-    e.grid = grid;
-    e.k = constants;
-    e.inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
-    e.inv_ell2 = 1.0 / (ell * ell);
-    return e;
-  }
-
-  // Runs per_point over every source point and returns the summed result (one host wait).
-  template <class Sums, class PerPoint>
-  Sums run(const Evaluation& e, PerPoint per_point, DeviceBuffer<Sums>& partials,
-           DeviceBuffer<Sums>& total, Sums* pinned_total, const char* what) {
-    partials.reserve(e.blocks);
-    sourcePointsKernel<<<e.blocks, kThreads, 0, stream>>>(e.source, e.pose, per_point,
-                                                          partials.data);
-    check(cudaGetLastError(), what);
-    return sumPartials(partials, e.blocks, total, pinned_total);
-  }
-
-  CloudView targetView() const {
-    return {sorted[0].data, sorted[1].data, sorted[2].data, count[0]};
-  }
-  CloudView sourceView() const {
-    return {raw[1][0].data, raw[1][1].data, raw[1][2].data, count[1]};
+  // Adds source point j's (at z) share of the moments over its candidates to m.
+  CVO_HOST_DEVICE void addMoments(int j, const float* z, kernels::MomentSums& m) const {
+    kernels::PointSums sums;
+    kernels::clear(sums);
+    forEachPair(j, z, [&](const float* x, float a) {
+      kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
+    });
+    if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
   }
 };
 
-DevicePairSums::DevicePairSums() : impl_(std::make_unique<Impl>()) {
-  check(cudaStreamCreateWithFlags(&impl_->stream, cudaStreamNonBlocking), "cudaStreamCreate");
-  check(cudaMallocHost(&impl_->pinned_moments, sizeof(kernels::MomentSums)), "cudaMallocHost");
-  check(cudaMallocHost(&impl_->pinned_taylor, sizeof(kernels::TaylorSums)), "cudaMallocHost");
-  check(cudaMallocHost(&impl_->pinned_curvature, sizeof(kernels::CurvatureSums)), "cudaMallocHost");
-}
-
-DevicePairSums::~DevicePairSums() {
-  if (impl_->pinned) cudaFreeHost(impl_->pinned);
-  if (impl_->pinned_moments) cudaFreeHost(impl_->pinned_moments);
-  if (impl_->pinned_taylor) cudaFreeHost(impl_->pinned_taylor);
-  if (impl_->pinned_curvature) cudaFreeHost(impl_->pinned_curvature);
-  if (impl_->stream) cudaStreamDestroy(impl_->stream);
-}
-
-void DevicePairSums::setCloud(bool target, const float* positions, const float* colors,
-                              const float* semantics, int count, int classes) {
-  Impl& d = *impl_;
-  const int which = target ? 0 : 1;
-  d.count[which] = count;
-  d.classes = classes;
-  if (target) d.target_has_color = colors != nullptr;
-  const auto n = static_cast<std::size_t>(count);
-  const float* data[3] = {positions, colors, semantics};
-  const std::size_t sizes[3] = {3 * n, colors ? kernels::kColorDim * n : 0,
-                                semantics ? static_cast<std::size_t>(classes) * n : 0};
-  d.upload(which, data, sizes);
-  if (target) {
-    d.host_positions.assign(positions, positions + 3 * n);
-    d.grid_cell = -1.0;  // rebuilt at the next evaluation
+// Source point j's share of an evaluation's sums: the point moved by the pose, then
+// add(context, j, z, sums) over its candidates.
+template <class Sums, class Add>
+struct ShareOfPoint {
+  PairContext c;
+  Add add;
+  CVO_HOST_DEVICE Sums operator()(int j) const {
+    Sums sums;
+    kernels::clear(sums);
+    float z[3];
+    c.moved(j, z);
+    add(c, j, z, sums);
+    return sums;
   }
-}
+};
 
-void DevicePairSums::setConstants(const kernels::KernelConstants& constants, double cutoff2) {
-  impl_->constants = constants;
-  impl_->cutoff2 = cutoff2;
-  impl_->grid_cell = -1.0;
-}
+struct AddMoments {
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::MomentSums& m) const {
+    c.addMoments(j, z, m);
+  }
+};
 
-kernels::MomentSums DevicePairSums::moments(const float* pose, double ell) {
-  Impl& d = *impl_;
-  const Evaluation e = d.evaluation(pose, ell);
-  auto per_point = [=] __device__(int j, const float* z, kernels::MomentSums& mine) {
-    const kernels::PointSums sums =
-        pointSums(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2);
-    if (sums.pairs > 0) kernels::accumulatePoint(mine, sums, z);
-  };
-  return d.run(e, per_point, d.moment_partials, d.moment_total, d.pinned_moments, "moments kernel");
-}
-
-kernels::TaylorSums DevicePairSums::taylor(const float* pose, const double* xi, double ell) {
-  Impl& d = *impl_;
-  const Evaluation e = d.evaluation(pose, ell);
-  Twist twist;
-  std::copy(xi, xi + 6, twist.v);
-  auto per_point = [=] __device__(int j, const float* z, kernels::TaylorSums& mine) {
+struct AddTaylor {
+  Twist xi;
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::TaylorSums& s) const {
     kernels::TaylorFrame frame;
-    kernels::makeTaylorFrame(z, twist.v, frame);
-    forEachPairWeight(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2,
-                      [&](const float* x, float a) {
-                        if (a > 0.0f)
-                          kernels::accumulateTaylorPair(mine, frame, x, z, a, e.inv_ell2);
-                      });
-  };
-  return d.run(e, per_point, d.taylor_partials, d.taylor_total, d.pinned_taylor, "taylor kernel");
-}
+    kernels::makeTaylorFrame(z, xi.v, frame);
+    c.forEachPair(j, z, [&](const float* x, float a) {
+      if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, c.inv_ell2);
+    });
+  }
+};
 
-kernels::CurvatureSums DevicePairSums::curvature(const float* pose, double ell) {
-  Impl& d = *impl_;
-  const Evaluation e = d.evaluation(pose, ell);
-  // Moments over every source point, the Hessian from every kCurvatureStride-th (as the CPU).
-  auto per_point = [=] __device__(int j, const float* z, kernels::CurvatureSums& mine) {
+// Moments over every source point, the Hessian from every kCurvatureStride-th (as the CPU).
+struct AddCurvature {
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+                                  kernels::CurvatureSums& out) const {
     if (j % kernels::kCurvatureStride != 0) {
-      const kernels::PointSums sums =
-          pointSums(e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2);
-      if (sums.pairs > 0) kernels::accumulatePoint(mine.moments, sums, z);
+      c.addMoments(j, z, out.moments);
       return;
     }
     kernels::PointCurvature sums;
     kernels::clear(sums);
-    const float inv_shell_width = kernels::inverseShellWidth(e.k.sp_thres);
-    forEachPairWeight(
-        e.target, e.source, e.grid, e.k, j, z, e.inv_two_ell2, [&](const float* x, float a) {
-          kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2],
-                                           e.k.sp_thres, inv_shell_width);
-        });
-    kernels::accumulatePointCurvature(mine, sums, z, e.inv_ell2, kernels::kCurvatureStride);
-  };
-  return d.run(e, per_point, d.curvature_partials, d.curvature_total, d.pinned_curvature,
-               "curvature kernel");
+    const float inv_shell_width = kernels::inverseShellWidth(c.k.sp_thres);
+    c.forEachPair(j, z, [&](const float* x, float a) {
+      kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2], c.k.sp_thres,
+                                       inv_shell_width);
+    });
+    kernels::accumulatePointCurvature(out, sums, z, c.inv_ell2, kernels::kCurvatureStride);
+  }
+};
+
+template <class Sums>
+struct AddSums {
+  CVO_HOST_DEVICE Sums operator()(Sums a, const Sums& b) const {
+    kernels::add(a, b);
+    return a;
+  }
+};
+
+// Grid build: the cell of target point i.
+struct CellOfPoint {
+  const float* positions;
+  kernels::DenseGridShape shape;
+  CVO_HOST_DEVICE unsigned operator()(int i) const {
+    return static_cast<unsigned>(kernels::cellOfPoint(shape, positions + 3 * i));
+  }
+};
+
+// Element k of the sorted copy of a row-major array of `width` floats a point comes from
+// element k % width of row order[k / width].
+struct SortedElement {
+  const unsigned* order;
+  unsigned width;
+  CVO_HOST_DEVICE unsigned operator()(unsigned k) const {
+    return order[k / width] * width + k % width;
+  }
+};
+
+template <class T>
+T* rawPointer(thrust::device_vector<T>& v) {
+  return thrust::raw_pointer_cast(v.data());
 }
 
-bool cudaDeviceUsable(std::string* why_not) {
-  int devices = 0;
-  const cudaError_t status = cudaGetDeviceCount(&devices);
-  if (status != cudaSuccess || devices == 0) {
-    if (why_not) {
-      *why_not = status != cudaSuccess
-                     ? std::string("no CUDA device: ") + cudaGetErrorString(status)
-                     : "no CUDA device found";
-    }
-    cudaGetLastError();  // clear the sticky error of a failed query
-    return false;
-  }
-  return true;
+// Grows v to at least n elements and never shrinks it: the storage is reused.
+template <class T>
+void grow(thrust::device_vector<T>& v, std::size_t n) {
+  if (v.size() < n) v.resize(n);
 }
+
+// Runs f with the system's errors (CUDA errors, device memory) as std::runtime_error naming
+// `what`, which FailoverBackend catches.
+template <class F>
+auto guarded(const char* what, F&& f) -> decltype(f()) {
+  const std::string context = std::string(device::kSystemName) + " " + what + ": ";
+  try {
+    return f();
+  } catch (const thrust::system_error& e) {
+    throw std::runtime_error(context + e.what());
+  } catch (const std::bad_alloc& e) {
+    throw std::runtime_error(context + "out of device memory (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+template <DeviceSystem System>
+struct DevicePairSums<System>::Impl {
+  static_assert(System == device::kSystem, "instantiated for the system it is compiled for");
+
+  explicit Impl(int threads) : runtime(threads) {}
+
+  device::Runtime runtime;
+  thrust::device_vector<float> uploaded[2][3];  // [target, source][positions, colours, semantics]
+  thrust::device_vector<float> sorted[3];       // the target in cell order
+  thrust::device_vector<unsigned> cell, order, start;
+  std::vector<float> host_positions;  // the target's, for the bounding box
+  int count[2] = {0, 0};
+  int classes = 0;
+  bool target_has_color = false;
+  kernels::KernelConstants constants{};
+  double cutoff2 = 0.0;
+  double grid_radius = -1.0;  // the query radius the grid was built for; -1: none
+  kernels::DenseGridShape shape{};
+
+  // The target sorted by grid cell (a stable sort of the cell indices) and each cell's first
+  // point (binary searches of every cell index in the sorted cells), all on the device.
+  void buildGrid(double radius) {
+    const int n = count[0];
+    float lo[3], hi[3];
+    kernels::boundingBox(host_positions.data(), static_cast<std::size_t>(n), lo, hi);
+    // Coarsen the cells when the box is huge (outdoor): still exact, just more points scanned.
+    float edge = static_cast<float>(radius);
+    double cells = kernels::shapeOverBox(lo, hi, edge, &shape);
+    while (cells > kernels::kMaxDenseCells) {
+      edge *= 1.5f;
+      cells = kernels::shapeOverBox(lo, hi, edge, &shape);
+    }
+    const auto total = static_cast<std::size_t>(cells);
+    grow(cell, n);
+    grow(order, n);
+    grow(start, total + 1);
+    auto policy = runtime.policy();
+    const thrust::counting_iterator<int> points(0);
+    thrust::transform(policy, points, points + n, cell.begin(),
+                      CellOfPoint{rawPointer(uploaded[0][0]), shape});
+    thrust::sequence(policy, order.begin(), order.begin() + n);
+    thrust::stable_sort_by_key(policy, cell.begin(), cell.begin() + n, order.begin());
+    // start[c] = the first sorted point of cell c; start[total] = n.
+    const thrust::counting_iterator<unsigned> cell_index(0);
+    thrust::lower_bound(policy, cell.begin(), cell.begin() + n, cell_index,
+                        cell_index + (total + 1), start.begin());
+    const int widths[3] = {3, target_has_color ? kernels::kColorDim : 0, classes};
+    for (int a = 0; a < 3; ++a) {
+      const std::size_t size = static_cast<std::size_t>(widths[a]) * n;
+      grow(sorted[a], size);
+      if (size == 0) continue;
+      const auto element = thrust::make_transform_iterator(
+          thrust::counting_iterator<unsigned>(0),
+          SortedElement{rawPointer(order), static_cast<unsigned>(widths[a])});
+      thrust::gather(policy, element, element + size, uploaded[0][a].begin(), sorted[a].begin());
+    }
+    grid_radius = radius;
+  }
+
+  // The grid for `ell` (rebuilt when the lengthscale changed) and what the functors read.
+  PairContext context(const float* pose, double ell) {
+    const double radius = std::sqrt(cutoff2) * ell;
+    if (grid_radius != radius) buildGrid(radius);
+    PairContext c;
+    c.target = {rawPointer(sorted[0]), rawPointer(sorted[1]), rawPointer(sorted[2])};
+    c.source = {rawPointer(uploaded[1][0]), rawPointer(uploaded[1][1]), rawPointer(uploaded[1][2])};
+    c.shape = shape;
+    c.start = rawPointer(start);
+    c.radius = static_cast<float>(radius);
+    // Beyond reach2 a pair's weight is below sp_thres by a factor exp(-0.001) at least: far
+    // more than rounding, so the skipped pairs are never retained ones.
+    c.reach2 = static_cast<float>((cutoff2 + 0.002) * ell * ell);
+    std::copy(pose, pose + 12, c.pose.m);
+    c.k = constants;
+    c.inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
+    c.inv_ell2 = 1.0 / (ell * ell);
+    return c;
+  }
+
+  // One transform_reduce over the source points, `add` giving each point's share at (pose,
+  // ell); one wait, for the result.
+  template <class Sums, class Add>
+  Sums sumOverSource(const float* pose, double ell, const Add& add) {
+    Sums zero;
+    kernels::clear(zero);
+    const thrust::counting_iterator<int> points(0);
+    return thrust::transform_reduce(runtime.policy(), points, points + count[1],
+                                    ShareOfPoint<Sums, Add>{context(pose, ell), add}, zero,
+                                    AddSums<Sums>{});
+  }
+};
+
+template <DeviceSystem System>
+DevicePairSums<System>::DevicePairSums(int threads) {
+  guarded("set-up", [&] { impl_ = std::make_unique<Impl>(threads); });
+}
+
+template <DeviceSystem System>
+DevicePairSums<System>::~DevicePairSums() = default;
+
+template <DeviceSystem System>
+void DevicePairSums<System>::setCloud(bool target, const float* positions, const float* colors,
+                                      const float* semantics, int count, int classes) {
+  guarded("upload", [&] {
+    Impl& d = *impl_;
+    const int which = target ? 0 : 1;
+    const auto n = static_cast<std::size_t>(count);
+    const float* host[3] = {positions, colors, semantics};
+    const std::size_t sizes[3] = {3 * n, colors ? kernels::kColorDim * n : 0,
+                                  semantics ? static_cast<std::size_t>(classes) * n : 0};
+    float* destination[3];
+    for (int a = 0; a < 3; ++a) {
+      grow(d.uploaded[which][a], sizes[a]);
+      destination[a] = rawPointer(d.uploaded[which][a]);
+    }
+    d.runtime.upload(3, host, sizes, destination);
+    d.count[which] = count;
+    d.classes = classes;
+    if (target) {
+      d.target_has_color = colors != nullptr;
+      d.host_positions.assign(positions, positions + 3 * n);
+      d.grid_radius = -1.0;  // rebuilt at the next evaluation
+    }
+  });
+}
+
+template <DeviceSystem System>
+void DevicePairSums<System>::setConstants(const kernels::KernelConstants& constants,
+                                          double cutoff2) {
+  impl_->constants = constants;
+  impl_->cutoff2 = cutoff2;
+  impl_->grid_radius = -1.0;
+}
+
+template <DeviceSystem System>
+kernels::MomentSums DevicePairSums<System>::moments(const float* pose, double ell) {
+  return guarded("moments", [&] {
+    return impl_->template sumOverSource<kernels::MomentSums>(pose, ell, AddMoments{});
+  });
+}
+
+template <DeviceSystem System>
+kernels::TaylorSums DevicePairSums<System>::taylor(const float* pose, const double* xi,
+                                                   double ell) {
+  return guarded("taylor", [&] {
+    AddTaylor add;
+    std::copy(xi, xi + 6, add.xi.v);
+    return impl_->template sumOverSource<kernels::TaylorSums>(pose, ell, add);
+  });
+}
+
+template <DeviceSystem System>
+kernels::CurvatureSums DevicePairSums<System>::curvature(const float* pose, double ell) {
+  return guarded("curvature", [&] {
+    return impl_->template sumOverSource<kernels::CurvatureSums>(pose, ell, AddCurvature{});
+  });
+}
+
+template class DevicePairSums<device::kSystem>;
 
 }  // namespace cvo

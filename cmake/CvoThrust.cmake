@@ -1,0 +1,57 @@
+# Decides CVO_DEVICE_CPU_ENABLED: the device_cpu backend, the device code
+# (src/core/cuda/device_pair_sums.cu) compiled by the host compiler for Thrust's OpenMP system, so
+# that the code a GPU runs is tested without one. Needs OpenMP and Thrust's headers: the CUDA
+# toolkit's when the CUDA backend is built (one Thrust for both builds of the source), else the
+# system's (Debian: libthrust-dev), else a toolkit's found on disk. CVO_THRUST_INCLUDE_DIR is the
+# one chosen.
+set(CVO_WITH_DEVICE_CPU "AUTO" CACHE STRING
+    "device_cpu backend (the device code on OpenMP threads): AUTO, ON or OFF")
+set_property(CACHE CVO_WITH_DEVICE_CPU PROPERTY STRINGS AUTO ON OFF)
+set(CVO_THRUST "AUTO" CACHE STRING
+    "Thrust for device_cpu: AUTO, CUDA (the toolkit's) or SYSTEM (e.g. libthrust-dev)")
+set_property(CACHE CVO_THRUST PROPERTY STRINGS AUTO CUDA SYSTEM)
+
+set(CVO_DEVICE_CPU_ENABLED OFF)
+set(CVO_THRUST_VERSION "")
+if(NOT CVO_WITH_DEVICE_CPU STREQUAL "OFF")
+  set(toolkit_roots ${CUDAToolkit_INCLUDE_DIRS} /usr/local/cuda/include)
+  set(toolkit_hints)
+  foreach(root ${toolkit_roots})
+    list(APPEND toolkit_hints ${root}/cccl ${root})  # CUDA 13 keeps CCCL in include/cccl
+  endforeach()
+  find_path(CVO_THRUST_TOOLKIT_DIR thrust/version.h PATHS ${toolkit_hints} NO_DEFAULT_PATH)
+  find_path(CVO_THRUST_SYSTEM_DIR thrust/version.h)
+  set(dir "")
+  if(CVO_THRUST STREQUAL "CUDA")
+    set(dir ${CVO_THRUST_TOOLKIT_DIR})
+  elseif(CVO_THRUST STREQUAL "SYSTEM")
+    set(dir ${CVO_THRUST_SYSTEM_DIR})
+  elseif(CVO_CUDA_ENABLED AND CVO_THRUST_TOOLKIT_DIR)
+    set(dir ${CVO_THRUST_TOOLKIT_DIR})
+  elseif(CVO_THRUST_SYSTEM_DIR)
+    set(dir ${CVO_THRUST_SYSTEM_DIR})
+  elseif(CVO_THRUST_TOOLKIT_DIR)
+    set(dir ${CVO_THRUST_TOOLKIT_DIR})
+  endif()
+  set(why "")
+  if(NOT dir)
+    set(why "no Thrust headers (${CVO_THRUST}; apt install libthrust-dev, or a CUDA toolkit)")
+  elseif(NOT OpenMP_CXX_FOUND)
+    set(why "no OpenMP for the C++ compiler")
+  endif()
+  if(why)
+    if(CVO_WITH_DEVICE_CPU STREQUAL "ON")
+      message(FATAL_ERROR "CVO_WITH_DEVICE_CPU=ON but ${why}")
+    endif()
+    message(STATUS "cvo_odometry: no device_cpu backend: ${why}")
+  else()
+    set(CVO_THRUST_INCLUDE_DIR ${dir})
+    file(STRINGS ${dir}/thrust/version.h version_line REGEX "^#define THRUST_VERSION ")
+    string(REGEX MATCH "[0-9]+" version "${version_line}")
+    math(EXPR major "${version} / 100000")
+    math(EXPR minor "${version} / 100 % 1000")
+    math(EXPR patch "${version} % 100")
+    set(CVO_THRUST_VERSION "${major}.${minor}.${patch}")
+    set(CVO_DEVICE_CPU_ENABLED ON)
+  endif()
+endif()
