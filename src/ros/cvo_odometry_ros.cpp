@@ -167,7 +167,10 @@ void CvoOdometryRos::subscribe() {
 
 void CvoOdometryRos::enqueue(const std_msgs::Header& header,
                              const std::function<CameraFrame()>& convert) {
-  if (paused_) return;
+  if (paused_) {
+    diagnostics_->countPaused();
+    return;
+  }
   try {
     queue_.push(QueuedFrame{header, convert()});
   } catch (const std::exception& e) {
@@ -190,7 +193,10 @@ void CvoOdometryRos::work() {
 
 void CvoOdometryRos::handle(const QueuedFrame& queued) {
   std::lock_guard<std::mutex> lock(pipeline_mutex_);
-  if (paused_) return;
+  if (paused_) {
+    diagnostics_->countPaused();
+    return;
+  }
   std_msgs::Header header = queued.header;
   if (!settings_.node.camera_frame.empty()) header.frame_id = settings_.node.camera_frame;
   if (!base_from_camera_) base_from_camera_ = baseFromCamera(header.frame_id);
@@ -269,7 +275,8 @@ void CvoOdometryRos::restart(const Eigen::Isometry3d& base_pose, const std::stri
   ROS_WARN_STREAM(pnh_.getNamespace() << ": " << why << ": the next frame starts a new odometry");
   queue_.clear();
   pipeline_->reset(base_pose);
-  base_from_camera_.reset();  // a transform published since is taken now
+  base_from_camera_.reset();              // a transform published since is taken now
+  if (rgbd_sync_) rgbd_sync_->relearn();  // the source may have other timing now
   path_.poses.clear();
   trajectory_ = Trajectory();
   diagnostics_->countReset();
@@ -298,6 +305,17 @@ void CvoOdometryRos::onReconfigure(CvoOdometryConfig& config, uint32_t) {
 Eigen::Isometry3d CvoOdometryRos::baseFromCamera(const std::string& camera_frame) {
   const NodeOptions& node = settings_.node;
   if (camera_frame.empty() || camera_frame == node.base_frame) return Eigen::Isometry3d::Identity();
+  if (!node.camera_transform.empty()) {
+    // Stated by the user: used as is, and published so that rviz and others see the same.
+    const Eigen::Isometry3d base_from_camera = poseFromXyzRpy(node.camera_transform);
+    geometry_msgs::TransformStamped stamped;
+    stamped.header.stamp = ros::Time::now();
+    stamped.header.frame_id = node.base_frame;
+    stamped.child_frame_id = camera_frame;
+    stamped.transform = toTransformMsg(base_from_camera);
+    static_broadcaster_.sendTransform(stamped);
+    return base_from_camera;
+  }
   try {
     return fromTransformMsg(tf_buffer_
                                 .lookupTransform(node.base_frame, camera_frame, ros::Time(0),

@@ -18,9 +18,13 @@ void NodeOptions::validate() const {
   if (odom_frame.empty() || base_frame.empty() || odom_frame == base_frame) {
     throw std::invalid_argument("odom_frame and base_frame must be two different names");
   }
-  if (!initial_pose.empty() && initial_pose.size() != 6) {
-    throw std::invalid_argument("initial_pose needs x, y, z, roll, pitch, yaw (6 numbers), got " +
-                                std::to_string(initial_pose.size()));
+  for (const auto& [name, values] : {std::pair{"initial_pose", &initial_pose},
+                                     std::pair{"camera_transform", &camera_transform}}) {
+    if (!values->empty() && values->size() != 6) {
+      throw std::invalid_argument(std::string(name) +
+                                  " needs x, y, z, roll, pitch, yaw (6 numbers), got " +
+                                  std::to_string(values->size()));
+    }
   }
   if (sync_policy == SyncPolicy::kOrdered && mode != CameraMode::kRgbd) {
     throw std::invalid_argument("sync_policy ordered is for RGB-D; use exact or approximate");
@@ -86,16 +90,19 @@ NodeSettings readNodeSettings(const ros::NodeHandle& pnh) {
   return settings;
 }
 
-Eigen::Isometry3d initialPose(const NodeOptions& options) {
+Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& p) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  if (options.initial_pose.size() != 6) return pose;
-  const auto& p = options.initial_pose;
+  if (p.size() != 6) return pose;
   pose.translation() << p[0], p[1], p[2];
   pose.linear() = (Eigen::AngleAxisd(p[5], Eigen::Vector3d::UnitZ()) *
                    Eigen::AngleAxisd(p[4], Eigen::Vector3d::UnitY()) *
                    Eigen::AngleAxisd(p[3], Eigen::Vector3d::UnitX()))
                       .toRotationMatrix();
   return pose;
+}
+
+Eigen::Isometry3d initialPose(const NodeOptions& options) {
+  return poseFromXyzRpy(options.initial_pose);
 }
 
 }  // namespace cvo

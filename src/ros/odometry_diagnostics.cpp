@@ -77,7 +77,8 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("skipped frames", skipped_);
   status.add("stale frames", stale_);
   status.add("frames dropped for latency", dropped);
-  const std::size_t handled = frames_ + skipped_ + stale_ + dropped;
+  status.add("frames dropped while paused", paused_);
+  const std::size_t handled = frames_ + skipped_ + stale_ + dropped + paused_;
   const std::size_t arrived = sync_.arrived ? sync_.arrived() : handled;
   status.add("frames not synchronized", arrived > handled ? arrived - handled : 0);
   if (const auto offset = sync_.offset ? sync_.offset() : std::nullopt) {

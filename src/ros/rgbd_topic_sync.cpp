@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include <ros/console.h>
 #include <boost/function.hpp>
 
 namespace cvo {
@@ -27,6 +28,36 @@ std::optional<double> RgbdTopicSync::learnedOffset() const {
   return std::isnan(offset) ? std::nullopt : std::optional<double>(offset);
 }
 
+void RgbdTopicSync::relearn() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (colour_depth_) colour_depth_->relearn();
+}
+
+void RgbdTopicSync::deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels) {
+  arrived_since_frame_ = 0;
+  callback_(image, depth, labels);
+}
+
+void RgbdTopicSync::countArrival(const ros::Time& stamp) {
+  ++arrived_;
+  // About a second of a 30 Hz camera, or a whole queue: a partner stream is missing or its
+  // stamps do not match (diagnostics count these as "frames not synchronized").
+  const std::size_t limit =
+      std::max<std::size_t>(30, static_cast<std::size_t>(options_.queue_size));
+  if (++arrived_since_frame_ < limit) return;
+  const double offset = offset_;
+  ROS_WARN_STREAM_THROTTLE(
+      5.0, "cvo_odometry: " << arrived_since_frame_
+                            << " colour images in a row made no frame (latest stamp " << stamp
+                            << "): is depth_registered/image_rect"
+                            << (options_.with_labels ? " (and segmentation/image)" : "")
+                            << " published, with matching stamps? sync_policy "
+                            << settingText(options_.policy)
+                            << (std::isnan(offset) ? std::string()
+                                                   : ", learned depth - colour offset " +
+                                                         std::to_string(offset) + " s"));
+}
+
 void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
                                      const image_transport::TransportHints& hints) {
   StampPairerOptions pairing;
@@ -45,7 +76,7 @@ void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
   subscribers_.push_back(
       it.subscribe("rgb/image_rect_color", queue,
                    boost::function<void(const ImagePtr&)>([this](const ImagePtr& image) {
-                     ++arrived_;
+                     countArrival(image->header.stamp);
                      std::lock_guard<std::mutex> lock(mutex_);
                      onPairs(colour_depth_->addFirst(image->header.stamp.toSec(), image));
                    }),
@@ -69,10 +100,20 @@ void RgbdTopicSync::subscribeOrdered(image_transport::ImageTransport& it,
 
 void RgbdTopicSync::onPairs(
     const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs) {
-  if (const auto offset = colour_depth_->offset()) offset_ = *offset;
+  if (colour_depth_->relearns() != relearns_logged_) {
+    relearns_logged_ = colour_depth_->relearns();
+    const double old = offset_;
+    ROS_WARN_STREAM(
+        "cvo_odometry: learning the depth - colour stamp offset again (a reset, "
+        "time going backwards, or frames that stopped pairing"
+        << (std::isnan(old) ? std::string() : " with the offset " + std::to_string(old) + " s")
+        << "); the next frames wait for it");
+  }
+  const auto offset = colour_depth_->offset();
+  offset_ = offset ? *offset : std::numeric_limits<double>::quiet_NaN();
   for (const auto& pair : pairs) {
     if (!with_labels_) {
-      callback_(pair.first, pair.second, nullptr);
+      deliver(pair.first, pair.second, nullptr);
       continue;
     }
     onLabelledFrames(with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second}));
@@ -82,7 +123,7 @@ void RgbdTopicSync::onPairs(
 void RgbdTopicSync::onLabelledFrames(
     const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames) {
   for (const auto& frame : frames)
-    callback_(frame.first.first, frame.first.second, frame.second);
+    deliver(frame.first.first, frame.first.second, frame.second);
 }
 
 void RgbdTopicSync::subscribeFilters(image_transport::ImageTransport& it,
@@ -94,8 +135,8 @@ void RgbdTopicSync::subscribeFilters(image_transport::ImageTransport& it,
   };
   auto rgb = image("rgb/image_rect_color");
   // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
-  rgb->registerCallback(
-      boost::function<void(const ImagePtr&)>([this](const ImagePtr&) { ++arrived_; }));
+  rgb->registerCallback(boost::function<void(const ImagePtr&)>(
+      [this](const ImagePtr& image) { countArrival(image->header.stamp); }));
   auto depth = image("depth_registered/image_rect");
   if (options_.with_labels) {
     auto labels = image("segmentation/image");

@@ -212,6 +212,62 @@ TEST(OrderedStampPairer, FixedZeroOffsetPairsEqualStampsOnly) {
   EXPECT_EQ(pairer.droppedSecond(), 1u);
 }
 
+// The excerpt's frames 0..17, then another source on the same topics (a driver restarted with
+// other settings): stamps jump 100 s ahead and depth now carries its colour image's stamp instead
+// of one ~15 ms older, so no depth falls in the learned window (an offset change of about a frame
+// period would instead look like a consistent pairing with the neighbour frame's depth; nothing
+// can tell those apart from stamps). Arrivals in stamp order.
+std::vector<Pairer::Pair> feedWithNewTiming(Pairer& pairer, const TumStamps& stamps) {
+  std::vector<Pairer::Pair> pairs;
+  auto keep = [&](const std::vector<Pairer::Pair>& done) {
+    pairs.insert(pairs.end(), done.begin(), done.end());
+  };
+  std::vector<std::pair<double, Arrival>> timed;  // the message is the colour image's index
+  for (int k = 0; k < 37; ++k) {
+    const double colour = stamps.rgb[k] + (k < 18 ? 0.0 : 100.0);
+    const double depth = k < 18 ? stamps.depth[stamps.depth_of_rgb[k]] : colour;
+    timed.push_back({colour, {0, k}});
+    timed.push_back({depth, {1, k}});
+  }
+  std::stable_sort(timed.begin(), timed.end(),  // equal stamps: colour first
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [stamp, a] : timed)
+    keep(a.stream == 0 ? pairer.addFirst(stamp, a.index) : pairer.addSecond(stamp, a.index));
+  return pairs;
+}
+
+TEST(OrderedStampPairer, LearnsTheOffsetAgainWhenFramesStopPairing) {
+  const TumStamps stamps = loadTumStamps();
+  Pairer pairer;
+  const auto pairs = feedWithNewTiming(pairer, stamps);
+  EXPECT_EQ(pairer.relearns(), 1u);
+  ASSERT_TRUE(pairer.offset().has_value());
+  EXPECT_NEAR(*pairer.offset(), 0.0, 1e-6);
+  std::size_t after_change = 0;
+  for (const auto& pair : pairs) {
+    // Second messages carry their colour image's index here (feedWithNewTiming).
+    EXPECT_EQ(pair.second, pair.first) << "colour " << pair.first << " mispaired";
+    if (pair.first >= 18) ++after_change;
+  }
+  // The first 10 frames of the new source go unpaired, the rest pair once the offset is known.
+  EXPECT_EQ(after_change, 37u - 18u - 10u);
+}
+
+TEST(OrderedStampPairer, RelearnOnRequestForgetsTheOffset) {
+  const TumStamps stamps = loadTumStamps();
+  Pairer pairer;
+  feed(pairer, stamps, arrivals(stamps, 0.0, 0.0));
+  ASSERT_TRUE(pairer.offset().has_value());
+  pairer.relearn();
+  EXPECT_FALSE(pairer.offset().has_value());
+  EXPECT_EQ(pairer.relearns(), 1u);
+  StampPairerOptions fixed;
+  fixed.fixed_offset = 0.0;
+  Pairer labels(fixed);
+  labels.relearn();
+  EXPECT_EQ(labels.offset(), std::optional<double>(0.0)) << "a fixed offset is kept";
+}
+
 TEST(OrderedStampPairer, RejectsBadStampsAndOptions) {
   Pairer pairer;
   EXPECT_TRUE(pairer.addFirst(std::numeric_limits<double>::quiet_NaN(), 0).empty());
@@ -226,6 +282,9 @@ TEST(OrderedStampPairer, RejectsBadStampsAndOptions) {
   EXPECT_THROW(Pairer{bad}, std::invalid_argument);
   bad = StampPairerOptions();
   bad.fixed_offset = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(Pairer{bad}, std::invalid_argument);
+  bad = StampPairerOptions();
+  bad.relearn_after_unpaired = 0;
   EXPECT_THROW(Pairer{bad}, std::invalid_argument);
 }
 

@@ -33,6 +33,9 @@ struct StampPairerOptions {
   std::size_t offset_window = 15;
   // Messages held per stream; beyond it the oldest is given up (counted as dropped).
   std::size_t queue_size = 30;
+  // First-stream messages given up in a row, with second-stream messages arriving, after which
+  // the learned offset is taken as wrong (the stream's timing changed) and learned again.
+  std::size_t relearn_after_unpaired = 10;
 
   void validate() const {
     if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
@@ -46,6 +49,9 @@ struct StampPairerOptions {
     }
     if (queue_size < bootstrap_frames) {
       throw std::invalid_argument("stamp pairer: queue_size must be >= bootstrap_frames");
+    }
+    if (relearn_after_unpaired < 1) {
+      throw std::invalid_argument("stamp pairer: relearn_after_unpaired must be >= 1");
     }
   }
 };
@@ -90,6 +96,21 @@ class OrderedStampPairer {
   // The offset (second - first) and tolerance in use; unset until the first frames are seen.
   std::optional<double> offset() const { return offset_; }
   std::optional<double> tolerance() const { return tolerance_; }
+  // Times the offset was learned afresh: after a restart of a stream, a run of
+  // relearn_after_unpaired unpaired messages, or relearn().
+  std::size_t relearns() const { return relearns_; }
+
+  // Forgets the learned offset (not a fixed one): the next frames teach it again. For a reset,
+  // or another source on the same topics.
+  void relearn() {
+    ++relearns_;
+    unpaired_run_ = 0;
+    if (options_.fixed_offset) return;
+    offset_.reset();
+    tolerance_.reset();
+    second_spacing_.reset();
+    recent_offsets_.clear();
+  }
 
  private:
   template <class T>
@@ -142,6 +163,7 @@ class OrderedStampPairer {
       }
       other.last =
           other.queue.empty() ? -std::numeric_limits<double>::infinity() : other.queue.back().stamp;
+      relearn();  // the replayed or new source may have other timing
     } else if (stamp == stream.last) {
       ++stream.dropped;  // a repeated stamp carries no new frame
       return;
@@ -209,6 +231,11 @@ class OrderedStampPairer {
         if (overflow || (!seconds_.empty() && seconds_.front().stamp > target + *tolerance_)) {
           firsts_.pop_front();
           ++dropped_first_;
+          if (++unpaired_run_ >= options_.relearn_after_unpaired && !options_.fixed_offset) {
+            relearn();
+            trimQueues();
+            return pairs;
+          }
           continue;
         }
         break;
@@ -221,6 +248,7 @@ class OrderedStampPairer {
       firsts_.pop_front();
       dropped_second_ += best;  // passed over: nearer to no first message
       seconds_.erase(seconds_.begin(), seconds_.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+      unpaired_run_ = 0;
       updateOffset(pairs.back().second_stamp - pairs.back().first_stamp);
     }
     trimQueues();
@@ -254,7 +282,8 @@ class OrderedStampPairer {
   double last_second_ = -std::numeric_limits<double>::infinity();
   std::optional<double> offset_, tolerance_, second_spacing_;
   std::deque<double> recent_offsets_;
-  std::size_t dropped_first_ = 0, dropped_second_ = 0, restarts_ = 0;
+  std::size_t dropped_first_ = 0, dropped_second_ = 0, restarts_ = 0, relearns_ = 0;
+  std::size_t unpaired_run_ = 0;  // first-stream messages given up since the last pair
 };
 
 }  // namespace cvo

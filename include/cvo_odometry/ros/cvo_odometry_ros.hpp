@@ -21,6 +21,7 @@
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 #include <boost/thread/recursive_mutex.hpp>
@@ -60,6 +61,7 @@ class CvoOdometryRos {
   // The next frame starts a new trajectory with the base at `base_pose`; base <- camera is
   // looked up again.
   void restart(const Eigen::Isometry3d& base_pose, const std::string& why);
+  // camera_transform when set (and published on /tf_static), else TF, else a forward camera.
   Eigen::Isometry3d baseFromCamera(const std::string& camera_frame);
   std::unique_ptr<RegistrationBackend> makeBackend(const CvoParams& params) const;
 
@@ -80,6 +82,7 @@ class CvoOdometryRos {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;  // camera_transform
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<cvo_odometry::CvoOdometryConfig>> reconfigure_;
   std::unique_ptr<OdometryDiagnostics> diagnostics_;

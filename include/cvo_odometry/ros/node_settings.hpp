@@ -25,6 +25,7 @@ struct NodeOptions {
   bool publish_tf = true;
   double tf_wait = 2.0;  // s
   std::vector<double> initial_pose;
+  std::vector<double> camera_transform;  // [] : base <- camera from TF
   SyncPolicy sync_policy = SyncPolicy::kAuto;
   int queue_size = 5;
   double sync_tolerance = 0.0;
@@ -68,6 +69,11 @@ void visitSettings(NodeSettings& s, V&& v) {
                 "the base's pose in odom at start: x, y, z (m), roll, pitch, yaw (rad); [] origin",
                 -1e6, 1e6},
     n.initial_pose);
+  v(SettingInfo{"camera_transform", "frames",
+                "the camera's optical frame in base_frame: x, y, z (m), roll, pitch, yaw (rad), "
+                "used and published on /tf_static; [] from TF",
+                -1e6, 1e6},
+    n.camera_transform);
   v(SettingInfo{"sync_policy", "sync", "auto: ordered for RGB-D, exact for stereo"}, n.sync_policy);
   v(SettingInfo{"queue_size", "sync", "subscriber and synchronizer queues (frames)", 1, 1000},
     n.queue_size);
@@ -98,6 +104,10 @@ void visitSettings(NodeSettings& s, V&& v) {
 // Defaults, then the preset (the `preset` parameter, else the mode's), then every private
 // parameter of a table name. Throws std::invalid_argument / FormatError naming a bad one.
 NodeSettings readNodeSettings(const ros::NodeHandle& pnh);
+
+// x, y, z, roll, pitch, yaw (REP-103: fixed-axis roll about x, then pitch, then yaw) as a pose;
+// identity when empty.
+Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& xyz_rpy);
 
 // The base's initial pose from NodeOptions::initial_pose (identity when empty).
 Eigen::Isometry3d initialPose(const NodeOptions& options);

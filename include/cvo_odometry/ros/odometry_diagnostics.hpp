@@ -1,7 +1,8 @@
 // The nodelet's diagnostics: the odometry rate, and a status (named after the nodelet, not its
 // manager) with every count a user needs to see what happened to the frames: processed,
-// skipped, stale, dropped for latency, not synchronized, lost, recovered, restarts, backend
-// fallbacks, resets; the latency from stamp to publish; the backend. ERROR while tracking is lost.
+// skipped, stale, dropped for latency or while paused, not synchronized, lost, recovered, restarts,
+// backend fallbacks, resets; the latency from stamp to publish; the backend. ERROR while tracking
+// is lost.
 #pragma once
 
 #include <functional>
@@ -32,6 +33,10 @@ class OdometryDiagnostics {
 
   void count(const PipelineResult& result, double latency_ms);
   void countSkipped(const std::string& why);  // before the pipeline (conversion, no camera_info)
+  void countPaused() {                        // a frame that came while ~pause was in effect
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++paused_;
+  }
   void countReset() {
     std::lock_guard<std::mutex> lock(mutex_);
     ++resets_;
@@ -44,7 +49,7 @@ class OdometryDiagnostics {
 
   SyncState sync_;
   std::mutex mutex_;
-  std::size_t frames_ = 0, skipped_ = 0, stale_ = 0, resets_ = 0;
+  std::size_t frames_ = 0, skipped_ = 0, stale_ = 0, paused_ = 0, resets_ = 0;
   std::size_t lost_ = 0, recovered_ = 0, restarts_ = 0, fallbacks_ = 0;
   bool lost_now_ = false;
   std::string lost_problem_, last_problem_, backend_;

@@ -44,6 +44,8 @@ class RgbdTopicSync {
   std::size_t arrived() const { return arrived_; }
   // Ordered policy: the learned depth - colour stamp offset (s), once known.
   std::optional<double> learnedOffset() const;
+  // Ordered policy: learn the offset again from the next frames (a reset); else nothing.
+  void relearn();
 
  private:
   using ImagePtr = sensor_msgs::ImageConstPtr;
@@ -56,17 +58,22 @@ class RgbdTopicSync {
   void onPairs(const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs);
   void onLabelledFrames(const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames);
   void onSynchronized(const ImagePtr& image, const ImagePtr& depth) {
-    callback_(image, depth, nullptr);
+    deliver(image, depth, nullptr);
   }
   void onSynchronizedWithLabels(const ImagePtr& image, const ImagePtr& depth,
                                 const ImagePtr& labels) {
-    callback_(image, depth, labels);
+    deliver(image, depth, labels);
   }
+  void deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels);
+  // A colour image arrived: warns when many in a row made no frame.
+  void countArrival(const ros::Time& stamp);
 
   RgbdSyncOptions options_;
   Callback callback_;
   std::atomic<std::size_t> arrived_{0};
+  std::atomic<std::size_t> arrived_since_frame_{0};
   std::atomic<double> offset_;  // NaN until learned
+  std::size_t relearns_logged_ = 0;
 
   // Ordered policy: pairing and delivery under one lock, so frames leave in stamp order.
   std::mutex mutex_;
