@@ -3,9 +3,12 @@
 // always processed, every older frame that waited is dropped and counted (diagnostics and the
 // indicator), and the latency from stamp to publish is reported. The assertions are on counts,
 // not on how fast this machine is: however many frames a slow machine drops, processed +
-// dropped is the number sent.
+// dropped is the number sent. The camera_transform parameter is published on /tf_static.
 #include <cmath>
 #include <string>
+
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "rostest_main.hpp"
 #include "tum_topic_driver.hpp"
@@ -64,6 +67,21 @@ TEST_F(Latency, NewestFrameProcessedEveryDropCounted) {
   EXPECT_GT(latency_ms, 0.0);
   EXPECT_LT(latency_ms, kEventTimeout * 1000.0);
   EXPECT_NEAR(newest.latency_ms, latency_ms, 1e-3 * latency_ms + 0.01);  // printed rounded
+}
+
+TEST_F(Latency, TheStatedCameraTransformIsPublished) {
+  // Sent when the first frame names the camera's frame (the test above sent them).
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  geometry_msgs::TransformStamped camera;
+  ASSERT_NO_THROW(camera = buffer.lookupTransform("base_link", "camera_rgb_optical_frame",
+                                                  ros::Time(0), ros::Duration(kEventTimeout)));
+  EXPECT_NEAR(camera.transform.translation.x, 0.1, 1e-9);
+  EXPECT_NEAR(camera.transform.translation.z, 0.3, 1e-9);
+  // Optical z forward = base x, optical x = base -y: the quaternion (0.5, -0.5, 0.5, -0.5).
+  const auto& q = camera.transform.rotation;
+  EXPECT_NEAR(std::abs(0.5 * q.w - 0.5 * q.x + 0.5 * q.y - 0.5 * q.z), 1.0, 1e-9)
+      << q.w << " " << q.x << " " << q.y << " " << q.z;
 }
 
 }  // namespace
