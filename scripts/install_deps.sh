@@ -18,8 +18,9 @@ full=("${core[@]}" libopencv-dev clang-format
   libcv-bridge-dev libimage-transport-dev libdiagnostic-updater-dev libdiagnostic-msgs-dev
   ros-diagnostic-msgs libstereo-image-proc-dev ros-stereo-image-proc python3-matplotlib
   libstd-srvs-dev ros-std-srvs libtf2-geometry-msgs-dev)
-# rviz only for watching (scripts/demo.sh --rviz): large, not needed by the tests.
-viz=("${full[@]}" rviz)
+# rviz only for watching (scripts/demo.sh --rviz) and the README picture (scripts/rviz_screenshot.sh:
+# Xvfb, xwd, xwininfo, ImageMagick): large, not needed by the tests.
+viz=("${full[@]}" rviz xvfb x11-apps x11-utils imagemagick)
 # The checking build (scripts/test_sanitizers.sh): clang with its sanitizer and libFuzzer runtimes
 # and its OpenMP (libomp: the CPU backend's threads and device_cpu).
 sanitize=("${core[@]}" libopencv-dev clang libclang-rt-14-dev libomp-14-dev)
