@@ -135,11 +135,17 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
   grid_radius_ = -1.0f;
   // Blocks keep their storage across problems: no reallocation (and page faults) per level.
   blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
+  block_radius_.resize(blocks_.size());
 }
 
-int CpuBackend::threadCount() const {
-  return resolvedThreadCount(num_threads_);
+double CpuBackend::farthestPoint() const {
+  return block_radius_.empty() ? 0.0
+                               : *std::max_element(block_radius_.begin(), block_radius_.end());
 }
+
+CpuBackend::CpuBackend(int num_threads)
+    : num_threads_(num_threads),
+      pool_(std::make_unique<BlockPool>(resolvedThreadCount(num_threads))) {}
 
 double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
   const Eigen::Isometry3d relative = T * built_pose_.inverse();
@@ -177,11 +183,9 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
   const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
-  const long block_count = static_cast<long>(blocks_.size());
-  double radius_max = 0.0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount()) reduction(max : radius_max)
-  for (long b = 0; b < block_count; ++b) {
+  pool_->run(blocks_.size(), [&](std::size_t b) {
     Block& block = blocks_[b];
+    double radius_max = 0.0;
     block.offsets.assign(1, 0);
     block.clear();
     const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
@@ -210,12 +214,13 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
       }
       block.offsets.push_back(static_cast<std::uint32_t>(block.size()));
     }
-  }
+    block_radius_[b] = radius_max;
+  });
   candidates_valid_ = true;
   built_ell_ = ell;
   margin_ = kSkin;
   built_pose_ = T;
-  built_radius_ = radius_max;
+  built_radius_ = farthestPoint();
 }
 
 void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin) {
@@ -225,12 +230,10 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
   const float reach2 = static_cast<float>(reach * reach);
   const float* src = source_->positionData().data();
-  const long block_count = static_cast<long>(blocks_.size());
-  double radius_max = 0.0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount()) reduction(max : radius_max)
-  for (long b = 0; b < block_count; ++b) {
+  pool_->run(blocks_.size(), [&](std::size_t b) {
     Block& block = blocks_[b];
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    double radius_max = 0.0;
+    const std::size_t begin = b * kBlockSize;
     const std::size_t points = block.offsets.size() - 1;
     std::uint32_t kept = 0, first = 0;
     for (std::size_t k = 0; k < points; ++k) {
@@ -249,22 +252,21 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
       block.offsets[k + 1] = kept;
     }
     block.resize(kept);
-  }
+    block_radius_[b] = radius_max;
+  });
   built_ell_ = ell;
   margin_ = margin;
   built_pose_ = T;
-  built_radius_ = radius_max;
+  built_radius_ = farthestPoint();
 }
 
 template <class Sums, class Fill>
 Sums CpuBackend::sumBlocks(Fill&& fill) const {
-  const long block_count = static_cast<long>(blocks_.size());
   std::vector<Sums> partial(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threadCount())
-  for (long b = 0; b < block_count; ++b) {
+  pool_->run(blocks_.size(), [&](std::size_t b) {
     kernels::clear(partial[b]);
-    fill(static_cast<std::size_t>(b), partial[b]);
-  }
+    fill(b, partial[b]);
+  });
   Sums total;
   kernels::clear(total);
   for (const auto& m : partial)

@@ -1,5 +1,8 @@
 #include "cvo_odometry/core/cvo_params.hpp"
 
+#include <algorithm>
+#include <thread>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -152,11 +155,11 @@ LostFramePolicy parseLostFramePolicy(const std::string& name) {
 }
 
 int resolvedThreadCount(int num_threads) {
+  if (num_threads > 0) return num_threads;
 #ifdef _OPENMP
-  return num_threads > 0 ? num_threads : omp_get_max_threads();
+  return omp_get_max_threads();  // OMP_NUM_THREADS when set, else the cores
 #else
-  (void)num_threads;
-  return 1;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 #endif
 }
 

@@ -61,7 +61,8 @@ Vector6d OdometryUpdate::baseTwist() const {
 
 KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
                                    std::unique_ptr<RegistrationBackend> backend)
-    : registration_(params, std::move(backend)) {}
+    : registration_(params, std::move(backend)),
+      photometric_pool_(resolvedThreadCount(params.num_threads)) {}
 
 void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   reference_.reset();
@@ -193,7 +194,8 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
         nearer ? last_good_->pose.inverse() * reference_pose_ : Eigen::Isometry3d::Identity();
     if (view.image() && cloud.image()) {
       PhotometricRotationResult refined = refineRotationPhotometrically(
-          *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p);
+          *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p,
+          &photometric_pool_);
       a.result.transform = view_from_reference.inverse() * refined.transform;
       a.photometric = refined.report;
     } else {
@@ -388,8 +390,7 @@ void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& c
   reference_covariance_ = covariance_;
 }
 
-bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update,
-                                     const OdometryFrame& frame) const {
+bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update) const {
   const CvoParams& p = params();
   return p.reference == ReferenceKind::kPreviousFrame ||
          update.state == TrackingState::kRecovered ||
@@ -417,7 +418,7 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   lost_frames_ = 0;
   if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;
   last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_};
-  update.new_keyframe = wantsKeyframe(update, frame);
+  update.new_keyframe = wantsKeyframe(update);
   if (update.new_keyframe) setReference(frame.cloud, update.stamp);
   fillBaseFrame(update, motion_covariance);
   update.base_frame_motion =

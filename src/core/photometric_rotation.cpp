@@ -32,7 +32,7 @@ double medianAbsolute(const std::vector<double>& residuals) {
 
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
-    const Eigen::Isometry3d& reference_from_current, const CvoParams& params) {
+    const Eigen::Isometry3d& reference_from_current, const CvoParams& params, BlockPool* pool) {
   const auto start = std::chrono::steady_clock::now();
   PhotometricRotationResult out;
   out.transform = reference_from_current;
@@ -56,8 +56,7 @@ PhotometricRotationResult refineRotationPhotometrically(
     points[j] = cloud.position(j).cast<double>();
 
   Eigen::Isometry3d T = reference_from_current;
-  const int threads = resolvedThreadCount(params.num_threads);
-  const long count = static_cast<long>(n);
+  constexpr std::size_t kPointsPerBlock = 512;
   // Per point (NaN residual: not observed), filled in parallel, then gathered in point order:
   // the same sums whatever the thread count.
   std::vector<double> own(n), point_residual(n);
@@ -68,29 +67,27 @@ PhotometricRotationResult refineRotationPhotometrically(
   jacobians.reserve(n);
   for (int level = 0; level < reference.levelCount(); ++level) {
     // Each point's intensity in its own image (where it was selected), at this blur.
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (long j = 0; j < count; ++j) {
+    forEachInBlocks(pool, n, kPointsPerBlock, [&](std::size_t j) {
       own[j] = NAN;
-      if (!(points[j].z() > 0.0)) continue;
+      if (!(points[j].z() > 0.0)) return;
       const Eigen::Vector2d p = current.camera().project(points[j]);
       if (current.inside(p.x(), p.y())) own[j] = current.sample(level, p.x(), p.y()).intensity;
-    }
+    });
     for (int it = 0; it < params.photometric_iterations; ++it) {
-#pragma omp parallel for num_threads(threads) schedule(static)
-      for (long j = 0; j < count; ++j) {
+      forEachInBlocks(pool, n, kPointsPerBlock, [&](std::size_t j) {
         point_residual[j] = NAN;
-        if (std::isnan(own[j])) continue;
+        if (std::isnan(own[j])) return;
         const Eigen::Vector3d Y = T * points[j];
-        if (!(Y.z() > 0.0)) continue;
+        if (!(Y.z() > 0.0)) return;
         const Eigen::Vector2d p = reference.camera().project(Y);
-        if (!reference.inside(p.x(), p.y())) continue;
+        if (!reference.inside(p.x(), p.y())) return;
         const IntensitySample s = reference.sample(level, p.x(), p.y());
         // d I / d Y, then the left perturbation Y + omega x Y + v.
         const Eigen::Vector3d dI = reference.camera().pinholeJacobian(Y).transpose() *
                                    Eigen::Vector2d(s.gradient_u, s.gradient_v);
         point_jacobian[j] << Y.cross(dI), dI;
         point_residual[j] = s.intensity - own[j];
-      }
+      });
       residuals.clear();
       jacobians.clear();
       sampled_own.clear();

@@ -145,9 +145,9 @@ TEST(PhotometricRotation, GivesTheSameRotationOnAnyThreadCount) {
   cvo::CvoParams params = presetParams();
   Eigen::Matrix4d first;
   for (const int threads : {1, 2, 3}) {
-    params.num_threads = threads;
+    cvo::BlockPool pool(threads);
     const cvo::PhotometricRotationResult out = cvo::refineRotationPhotometrically(
-        *pair.reference.image(), *pair.current.image(), pair.current, guess, params);
+        *pair.reference.image(), *pair.current.image(), pair.current, guess, params, &pool);
     ASSERT_TRUE(out.report.applied) << out.report.skipped;
     if (threads == 1) first = out.transform.matrix();
     EXPECT_EQ(out.transform.matrix(), first) << threads << " threads";

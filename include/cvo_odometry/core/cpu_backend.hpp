@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "cvo_odometry/core/block_pool.hpp"
 #include "cvo_odometry/core/registration_backend.hpp"
 #include "cvo_odometry/core/voxel_grid.hpp"
 
@@ -14,8 +16,8 @@ namespace cvo {
 
 class CpuBackend : public RegistrationBackend {
  public:
-  // `num_threads` 0: OpenMP's default (all cores).
-  explicit CpuBackend(int num_threads = 0) : num_threads_(num_threads) {}
+  // `num_threads` 0: all cores (OpenMP's default count).
+  explicit CpuBackend(int num_threads = 0);
 
   std::string name() const override { return "cpu"; }
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
@@ -61,6 +63,8 @@ class CpuBackend : public RegistrationBackend {
   // is a filter of the old one, with the old margin less what the source moved since.
   void refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin);
   double movedSinceBuild(const Eigen::Isometry3d& T) const;
+  // The largest block_radius_ (0 without blocks).
+  double farthestPoint() const;
   // The target's grid with this cell size (kept while the problem and size stay).
   void ensureGrid(float radius);
   // Moments straight from the grid at the cut-off radius (no lists): point_sums(j, T z_j,
@@ -77,9 +81,9 @@ class CpuBackend : public RegistrationBackend {
   // The moment sums of point k of `block` (at z) over its candidate list.
   kernels::PointSums listSums(const Block& block, std::size_t k, const float* z,
                               float inv_two_ell2) const;
-  int threadCount() const;
-
   int num_threads_;
+  std::unique_ptr<BlockPool> pool_;   // the blocks' threads
+  std::vector<double> block_radius_;  // per block: the farthest transformed source point
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   kernels::KernelConstants constants_{};

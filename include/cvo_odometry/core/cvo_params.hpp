@@ -133,7 +133,7 @@ struct CvoParams {
   double maxKernelWeight() const;
 };
 
-// Threads for `num_threads` (0: OpenMP's default, all cores; 1 without OpenMP).
+// Threads for `num_threads` (0: all cores, or OMP_NUM_THREADS when set).
 int resolvedThreadCount(int num_threads);
 
 // Value names, for the settings table (settings_table.hpp: settingText, parseEnum).

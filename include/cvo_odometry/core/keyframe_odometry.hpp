@@ -19,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/block_pool.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/motion_prior.hpp"
 #include "cvo_odometry/core/photometric_rotation.hpp"
@@ -149,7 +150,7 @@ class KeyframeOdometry {
   std::optional<Eigen::Isometry3d> constantVelocityMotion(double interval) const;
   Eigen::Isometry3d stillMotion() const;  // reference <- previous frame
   void accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame);
-  bool wantsKeyframe(const OdometryUpdate& update, const OdometryFrame& frame) const;
+  bool wantsKeyframe(const OdometryUpdate& update) const;
   // `cloud` becomes the reference at the current pose; none when it is missing or has fewer
   // than min_tracking_points.
   void setReference(const std::shared_ptr<const LabeledCloud>& cloud, double stamp);
@@ -159,6 +160,7 @@ class KeyframeOdometry {
   void fillBaseFrame(OdometryUpdate& update, const Matrix6d& motion_covariance);
 
   CvoRegistration registration_;
+  BlockPool photometric_pool_;  // num_threads threads for the photometric stage
   std::shared_ptr<const LabeledCloud> reference_;
   // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
   std::optional<std::pair<double, double>> reference_self_, source_self_;

@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/block_pool.hpp"
 #include "cvo_odometry/core/cvo_params.hpp"
 #include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
@@ -40,9 +41,11 @@ struct PhotometricRotationResult {
 // images' levels differ, too few points (< params.min_tracking_points) land in the reference
 // image, the solve degenerates, the intensities correlate below 0.5 at the result (the images
 // do not show the same scene: a black frame, a covered lens), or the correction exceeds
-// params.photometric_max_correction.
+// params.photometric_max_correction. The points are evaluated on `pool` (null: this thread);
+// the result is the same on any thread count.
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
-    const Eigen::Isometry3d& reference_from_current, const CvoParams& params);
+    const Eigen::Isometry3d& reference_from_current, const CvoParams& params,
+    BlockPool* pool = nullptr);
 
 }  // namespace cvo
