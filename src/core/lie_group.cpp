@@ -35,6 +35,16 @@ Eigen::Matrix3d expSO3(const Eigen::Vector3d& omega) {
   return Eigen::Matrix3d::Identity() + a * W + b * W * W;
 }
 
+Eigen::Isometry3d fromXyzRpy(double x, double y, double z, double roll, double pitch, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() << x, y, z;
+  return T;
+}
+
 double rotationAngle(const Eigen::Matrix3d& R) {
   // atan2 form is accurate over the whole range, unlike acos of the trace.
   const double c = 0.5 * (R.trace() - 1.0);

@@ -3,6 +3,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/frontend/builtin_presets.hpp"
 
 namespace cvo {
@@ -91,14 +92,8 @@ NodeSettings readNodeSettings(const ros::NodeHandle& pnh) {
 }
 
 Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& p) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  if (p.size() != 6) return pose;
-  pose.translation() << p[0], p[1], p[2];
-  pose.linear() = (Eigen::AngleAxisd(p[5], Eigen::Vector3d::UnitZ()) *
-                   Eigen::AngleAxisd(p[4], Eigen::Vector3d::UnitY()) *
-                   Eigen::AngleAxisd(p[3], Eigen::Vector3d::UnitX()))
-                      .toRotationMatrix();
-  return pose;
+  if (p.size() != 6) return Eigen::Isometry3d::Identity();
+  return lie::fromXyzRpy(p[0], p[1], p[2], p[3], p[4], p[5]);
 }
 
 Eigen::Isometry3d initialPose(const NodeOptions& options) {

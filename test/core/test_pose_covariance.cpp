@@ -28,13 +28,7 @@ Vector6d logTranslationFirst(const Eigen::Isometry3d& T) {
 }
 
 Eigen::Isometry3d motion(double rx, double ry, double rz, double tx, double ty, double tz) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << tx, ty, tz;
-  return T;
+  return cvo::lie::fromXyzRpy(tx, ty, tz, rx, ry, rz);
 }
 
 // A motion noise with correlations, a few mm and tenths of a degree.

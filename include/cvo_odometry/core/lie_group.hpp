@@ -35,5 +35,9 @@ Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T);
 
 double rotationAngle(const Eigen::Matrix3d& R);
 
+// The pose at (x, y, z) turned by roll about x, then pitch about y, then yaw about z, all about
+// the fixed axes (REP-103; R = Rz(yaw) Ry(pitch) Rx(roll)).
+Eigen::Isometry3d fromXyzRpy(double x, double y, double z, double roll, double pitch, double yaw);
+
 }  // namespace lie
 }  // namespace cvo
