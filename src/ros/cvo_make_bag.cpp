@@ -30,7 +30,8 @@ const char* kUsage =
     "  --frame-id NAME    camera frame (camera_rgb_optical_frame / camera_left)\n"
     "  --base-frame NAME  the frame /tf_static puts the camera in (base_link)\n"
     "  --gt-out FILE      ground truth (TUM format) at the bag's stamps, for cvo_evaluate\n"
-    "  --first N --last N frame range\n";
+    "  --first N --last N frame range\n"
+    "  --stride N         every N-th frame of the range (larger motions per frame)\n";
 
 sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
                                    const std_msgs::Header& header) {
@@ -72,7 +73,7 @@ int main(int argc, char** argv) {
   try {
     const cvo::CommandLine cli(argc, argv,
                                {"tum", "kitti", "camera", "out", "ns", "frame-id", "base-frame",
-                                "gt-out", "first", "last"},
+                                "gt-out", "first", "last", "stride"},
                                {"help"});
     if (cli.has("help") || (!cli.has("tum") && !cli.has("kitti"))) {
       std::cout << kUsage;
@@ -80,6 +81,8 @@ int main(int argc, char** argv) {
     }
     rosbag::Bag bag(cli.require("out"), rosbag::bagmode::Write);
     const int first = cli.getInt("first", 0);
+    const int stride = cli.getInt("stride", 1);
+    if (stride < 1) throw std::invalid_argument("--stride must be >= 1");
     const std::string base_frame = cli.get("base-frame", "base_link");
     std::size_t written = 0;
     cvo::Trajectory ground_truth;  // at the bag's stamps
@@ -92,7 +95,7 @@ int main(int argc, char** argv) {
       const int last = cli.getInt("last", static_cast<int>(sequence.frames().size()) - 1);
       std_msgs::Header header;
       header.frame_id = cli.get("frame-id", "camera_rgb_optical_frame");
-      for (int k = first; k <= last; ++k) {
+      for (int k = first; k <= last; k += stride) {
         cv::Mat image, depth;
         sequence.load(static_cast<std::size_t>(k), &image, &depth);
         const auto& f = sequence.frames()[static_cast<std::size_t>(k)];
@@ -122,7 +125,7 @@ int main(int argc, char** argv) {
       const int last = cli.getInt("last", static_cast<int>(sequence.size()) - 1);
       std_msgs::Header header;
       header.frame_id = cli.get("frame-id", "camera_left");
-      for (int k = first; k <= last; ++k) {
+      for (int k = first; k <= last; k += stride) {
         cv::Mat left, right;
         sequence.load(static_cast<std::size_t>(k), &left, &right, nullptr);
         cv::cvtColor(left, left, cv::COLOR_BGR2GRAY);

@@ -121,6 +121,7 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     const auto& indicator = collected.indicators[k];
     EXPECT_FALSE(indicator.first_frame) << "frame " << k;
     EXPECT_TRUE(indicator.converged) << "frame " << k << ": " << indicator.message;
+    EXPECT_TRUE(indicator.trusted) << "frame " << k << " not tracked: " << indicator.problem;
     EXPECT_GT(indicator.iterations, 0);
     EXPECT_GT(indicator.cosine, 0.0);
     EXPECT_LE(indicator.cosine, 1.0 + 1e-9);
