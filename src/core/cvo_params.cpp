@@ -32,7 +32,8 @@ void CvoParams::validate() const {
   requirePositive(ell_min, "ell_min");
   requirePositive(ell_first_frame, "ell_first_frame");
   requirePositive(sigma, "sigma");
-  requirePositive(sp_thres, "sp_thres");
+  require(sp_ratio >= 0.0 && sp_ratio < 1.0, "sp_ratio must be in [0, 1)");
+  if (sp_ratio == 0.0) requirePositive(sp_thres, "sp_thres");
   require(ell_min <= ell_init, "ell_min (" + std::to_string(ell_min) + ") > ell_init (" +
                                    std::to_string(ell_init) + ")");
   require(ell_min <= ell_first_frame, "ell_min > ell_first_frame");
@@ -46,9 +47,12 @@ void CvoParams::validate() const {
   }
   // The largest possible pair weight must clear the threshold, or no pair is ever retained.
   const double max_weight = maxKernelWeight();
-  require(max_weight > sp_thres, "sp_thres (" + std::to_string(sp_thres) +
-                                     ") is not below the largest kernel product (" +
-                                     std::to_string(max_weight) + "): no pair could count");
+  require(sp_ratio > 0.0 || max_weight > sp_thres,
+          "sp_thres (" + std::to_string(sp_thres) +
+              ") is not below the largest kernel product of the enabled kernels (" +
+              std::to_string(max_weight) +
+              "): no pair could count; lower sp_thres below that, or set sp_ratio (e.g. 0.3: "
+              "the threshold then follows the kernels)");
   require(decay_rate > 0.0 && decay_rate <= 1.0, "decay_rate must be in (0, 1]");
   require(first_frame_decay_rate > 0.0 && first_frame_decay_rate <= 1.0,
           "first_frame_decay_rate must be in (0, 1]");

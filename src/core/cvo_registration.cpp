@@ -120,7 +120,8 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     }
     // The MM fixed point is a stationary point of the continuous sum_ij (a_ij - sp_thres)_+
     // (the retained-pair sum F jumps as pairs cross the threshold): steer by that.
-    const double smooth_weight = m.weight - params_.sp_thres * static_cast<double>(m.pairs);
+    const double smooth_weight =
+        m.weight - params_.retainThreshold() * static_cast<double>(m.pairs);
     const bool fell = previous_weight >= 0.0 && smooth_weight < previous_weight;
     // A Newton step after which F fell: its quadratic model misleads here, MM steps from now on.
     if (fell && last_was_newton) newton_allowed = false;

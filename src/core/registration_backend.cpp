@@ -5,13 +5,13 @@
 namespace cvo {
 
 double retainedScaledDistance2(const CvoParams& params) {
-  return 2.0 * std::log(params.maxKernelWeight() / params.sp_thres);
+  return 2.0 * std::log(params.maxKernelWeight() / params.retainThreshold());
 }
 
 kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semantic_classes) {
   kernels::KernelConstants k{};
   k.max_weight = static_cast<float>(params.maxKernelWeight());
-  k.sp_thres = static_cast<float>(params.sp_thres);
+  k.sp_thres = static_cast<float>(params.retainThreshold());
   k.use_color = params.use_color ? 1 : 0;
   k.color_inv_ell2 = static_cast<float>(1.0 / (params.color_ell * params.color_ell));
   k.semantic_classes = params.use_semantics ? semantic_classes : 0;

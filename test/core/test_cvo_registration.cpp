@@ -8,6 +8,7 @@
 #include "cvo_odometry/core/cvo_steps.hpp"
 #include "cvo_odometry/core/failover_backend.hpp"
 #include "cvo_odometry/core/fault_injection_backend.hpp"
+#include "cvo_odometry/core/lie_group.hpp"
 #include "synthetic_scene.hpp"
 
 using cvo::CvoParams;
@@ -31,13 +32,7 @@ CvoParams syntheticParams(bool color) {
 }
 
 Eigen::Isometry3d pose(double rx, double ry, double rz, double tx, double ty, double tz) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
-                Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() << tx, ty, tz;
-  return T;
+  return cvo::lie::fromXyzRpy(tx, ty, tz, rx, ry, rz);
 }
 
 double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -270,6 +265,21 @@ TEST(CvoRegistration, BadInputGivesClearErrors) {
   EXPECT_THROW(registration.align(good, good, bad_guess), std::invalid_argument);
 }
 
+TEST(CvoParams, TheRetainThresholdFollowsTheEnabledKernels) {
+  CvoParams p;
+  EXPECT_DOUBLE_EQ(p.retainThreshold(), p.sp_thres) << "the paper's absolute form by default";
+  p.sp_ratio = 0.3;  // sigma 0.1: the paper's sp_thres 0.003 with geometry only
+  EXPECT_NEAR(p.retainThreshold(), 0.003, 1e-12);
+  p.use_color = true;  // color_sigma 0.6: largest product 0.0036, threshold 0.00108
+  EXPECT_NEAR(p.retainThreshold(), 0.3 * 0.0036, 1e-12);
+  p.use_semantics = true;  // semantic_sigma 0.8
+  EXPECT_NEAR(p.retainThreshold(), 0.3 * 0.0036 * 0.64, 1e-12);
+  EXPECT_NO_THROW(p.validate()) << "colour and semantics at their defaults retain pairs";
+  p.sp_ratio = 0.0;  // the absolute form: sp_thres as given, whatever the kernels
+  EXPECT_DOUBLE_EQ(p.retainThreshold(), p.sp_thres);
+  EXPECT_THROW(p.validate(), std::invalid_argument) << "0.003 is above 0.0036 * 0.64";
+}
+
 TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   auto message = [](const CvoParams& p) -> std::string {
     try {
@@ -289,6 +299,10 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   p = CvoParams();
   p.sp_thres = 0.02;  // s^2 = 0.01
   EXPECT_NE(message(p).find("no pair could count"), std::string::npos);
+  EXPECT_NE(message(p).find("set sp_ratio"), std::string::npos) << "says what to change";
+  p = CvoParams();
+  p.sp_ratio = 1.0;
+  EXPECT_NE(message(p).find("sp_ratio must be in [0, 1)"), std::string::npos);
   p = CvoParams();
   p.min_step = 1.0;
   EXPECT_NE(message(p).find("min_step > max_step"), std::string::npos);

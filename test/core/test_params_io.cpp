@@ -28,13 +28,14 @@ TEST(ParamsIo, PresetsLoadWithThePapersValues) {
   const cvo::CvoParams tum =
       cvo::loadCvoParams(configPath("tum_rgbd.yaml"), {}, cvo::UnknownKeys::kIgnore);
   EXPECT_DOUBLE_EQ(tum.ell_init, 0.15);
-  EXPECT_DOUBLE_EQ(tum.sp_thres, 0.003);
+  EXPECT_NEAR(tum.retainThreshold(), 0.003, 1e-12);  // the paper's sp_thres, geometry only
   EXPECT_DOUBLE_EQ(tum.color_sigma, 0.6);
   EXPECT_EQ(tum.step_method, cvo::StepMethod::kProcrustes);
   const cvo::CvoParams kitti =
       cvo::loadCvoParams(configPath("kitti_stereo.yaml"), {}, cvo::UnknownKeys::kIgnore);
   EXPECT_DOUBLE_EQ(kitti.ell_first_frame, 0.95);
-  EXPECT_DOUBLE_EQ(kitti.sp_thres, 0.007);
+  EXPECT_DOUBLE_EQ(kitti.sp_ratio, 0.7);
+  EXPECT_NEAR(kitti.retainThreshold(), 0.007, 1e-12);  // the paper's sp_thres at its kernels
   EXPECT_EQ(kitti.indicator_window, 30);
   EXPECT_EQ(kitti.max_iterations, 10000);
 }

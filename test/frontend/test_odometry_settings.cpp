@@ -37,7 +37,7 @@ TEST(OdometrySettings, ShippedPresetsLoadByNameAndByFile) {
   EXPECT_EQ(by_name.cloud.crop_top_rows, 100);
   EXPECT_DOUBLE_EQ(by_name.cloud.max_depth, 55.0);
   EXPECT_DOUBLE_EQ(by_name.cvo.ell_first_frame, 0.95);
-  EXPECT_DOUBLE_EQ(by_name.cvo.sp_thres, 0.007);
+  EXPECT_DOUBLE_EQ(by_name.cvo.sp_ratio, 0.7);
   EXPECT_EQ(by_name.cvo.max_iterations, 10000);
   // The defaults are the RGB-D camera's: the TUM preset changes nothing.
   cvo::OdometrySettings tum;

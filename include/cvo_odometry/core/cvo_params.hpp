@@ -47,6 +47,12 @@ struct CvoParams {
   double ell_min = 0.02;
   double ell_first_frame = 0.15;
   double sigma = 0.1;
+  // A pair counts when its kernel product a_ij exceeds the retain threshold: with sp_ratio > 0,
+  // sp_ratio times the largest product the enabled kernels can give (sigma^2 color_sigma^2
+  // semantic_sigma^2), so that switching a kernel on or changing an amplitude keeps the same
+  // neighbourhood; with sp_ratio 0 (default), the paper's absolute sp_thres.
+  // retainThreshold() is the one conversion.
+  double sp_ratio = 0.0;
   double sp_thres = 0.003;
 
   // Appearance kernels s_V^2 exp(-|u - v|^2 / (2 ell_V^2)), multiplied into the pair weight.
@@ -131,6 +137,10 @@ struct CvoParams {
   void validate() const;
   // The largest pair weight: s^2 times s_V^2 of every appearance kernel in use.
   double maxKernelWeight() const;
+  // The kernel product a pair must exceed to count (see sp_ratio).
+  double retainThreshold() const {
+    return sp_ratio > 0.0 ? sp_ratio * maxKernelWeight() : sp_thres;
+  }
 };
 
 // Threads for `num_threads` (0: all cores, or OMP_NUM_THREADS when set).

@@ -21,8 +21,13 @@ void visitSettings(CvoParams& p, V&& v) {
                 0.005, 3.0},
     p.ell_first_frame);
   v(SettingInfo{"sigma", "kernels", "geometric kernel amplitude s", 0.001, 10.0}, p.sigma);
-  v(SettingInfo{"sp_thres", "kernels", "a pair counts only if its kernel product exceeds this", 0.0,
-                0.5},
+  v(SettingInfo{"sp_ratio", "kernels",
+                "a pair counts only if its kernel product exceeds this fraction of the largest "
+                "product of the enabled kernels; 0: sp_thres (the paper's form) instead",
+                0.0, 0.99},
+    p.sp_ratio);
+  v(SettingInfo{"sp_thres", "kernels",
+                "with sp_ratio 0: a pair counts only if its kernel product exceeds this", 0.0, 0.5},
     p.sp_thres);
   v(SettingInfo{"use_color", "kernels", "colour kernel on (5-D: B, G, R, two image gradients)"},
     p.use_color);
