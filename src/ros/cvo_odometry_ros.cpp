@@ -248,8 +248,10 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const PipelineResul
   // Bounded: a long run must not grow memory or the message without limit.
   const auto keep = static_cast<std::size_t>(node.max_path_poses);
   if (path_.poses.size() > keep) path_.poses.erase(path_.poses.begin(), path_.poses.end() - keep);
+  // The camera's trajectory, as documented and as cvo_run_sequence writes it: comparable with a
+  // dataset's ground truth, which is the camera's.
   if (!node.trajectory_file.empty())
-    trajectory_.append(header.stamp.toSec(), result.update.base_pose);
+    trajectory_.append(header.stamp.toSec(), result.update.base_pose * *base_from_camera_);
   if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(path_);
   publishClouds(header, result);
 }

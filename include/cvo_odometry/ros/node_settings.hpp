@@ -91,7 +91,8 @@ void visitSettings(NodeSettings& s, V&& v) {
     n.process_every_frame);
   v(SettingInfo{"use_segmentation", "semantics", "subscribe segmentation/image"},
     n.use_segmentation);
-  v(SettingInfo{"trajectory_file", "output", "write the trajectory (TUM format) at shutdown"},
+  v(SettingInfo{"trajectory_file", "output",
+                "write the camera's trajectory (TUM format; the ground truth's frame) at shutdown"},
     n.trajectory_file);
   v(SettingInfo{"max_path_poses", "output", "the path topic keeps this many latest poses", 1,
                 10000000},
