@@ -122,6 +122,8 @@ void CpuBackend::Block::move(std::size_t from, std::size_t to) {
   }
 }
 
+CpuBackend::CpuBackend(int num_threads) : pool_(resolvedThreadCount(num_threads)) {}
+
 void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& source,
                             const CvoParams& params) {
   target_ = &target;
@@ -142,10 +144,6 @@ double CpuBackend::farthestPoint() const {
   return block_radius_.empty() ? 0.0
                                : *std::max_element(block_radius_.begin(), block_radius_.end());
 }
-
-CpuBackend::CpuBackend(int num_threads)
-    : num_threads_(num_threads),
-      pool_(std::make_unique<BlockPool>(resolvedThreadCount(num_threads))) {}
 
 double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
   const Eigen::Isometry3d relative = T * built_pose_.inverse();
@@ -183,7 +181,7 @@ void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
   const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
-  pool_->run(blocks_.size(), [&](std::size_t b) {
+  pool_.run(blocks_.size(), [&](std::size_t b) {
     Block& block = blocks_[b];
     double radius_max = 0.0;
     block.offsets.assign(1, 0);
@@ -230,7 +228,7 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
   const float reach2 = static_cast<float>(reach * reach);
   const float* src = source_->positionData().data();
-  pool_->run(blocks_.size(), [&](std::size_t b) {
+  pool_.run(blocks_.size(), [&](std::size_t b) {
     Block& block = blocks_[b];
     double radius_max = 0.0;
     const std::size_t begin = b * kBlockSize;
@@ -263,7 +261,7 @@ void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, doub
 template <class Sums, class Fill>
 Sums CpuBackend::sumBlocks(Fill&& fill) const {
   std::vector<Sums> partial(blocks_.size());
-  pool_->run(blocks_.size(), [&](std::size_t b) {
+  pool_.run(blocks_.size(), [&](std::size_t b) {
     kernels::clear(partial[b]);
     fill(b, partial[b]);
   });

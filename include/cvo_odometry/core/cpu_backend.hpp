@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "cvo_odometry/core/block_pool.hpp"
@@ -81,8 +80,7 @@ class CpuBackend : public RegistrationBackend {
   // The moment sums of point k of `block` (at z) over its candidate list.
   kernels::PointSums listSums(const Block& block, std::size_t k, const float* z,
                               float inv_two_ell2) const;
-  int num_threads_;
-  std::unique_ptr<BlockPool> pool_;   // the blocks' threads
+  mutable BlockPool pool_;            // the blocks' threads (sums run from const members too)
   std::vector<double> block_radius_;  // per block: the farthest transformed source point
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
