@@ -104,9 +104,12 @@ Eigen::Isometry3d KeyframeOdometry::stillMotion() const {
   return lie::orthonormalized(reference_pose_.inverse() * pose_);
 }
 
+bool KeyframeOdometry::priorJudges(const std::optional<MotionPrior>& prior) const {
+  return prior && prior->solved && prior->inliers >= params().min_prior_inliers;
+}
+
 bool KeyframeOdometry::priorConfident(const std::optional<MotionPrior>& prior) const {
-  return prior && prior->solved && prior->inliers >= params().min_prior_inliers &&
-         prior->inlier_ratio >= params().min_prior_inlier_ratio;
+  return priorJudges(prior) && prior->inlier_ratio >= params().min_prior_inlier_ratio;
 }
 
 void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval,
@@ -202,8 +205,10 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       a.photometric.skipped = "the clouds carry no image";
     }
   }
-  // The feature tracks, independent of CVO, catch a registration stuck near a wrong guess.
-  if (priorConfident(frame.prior)) {
+  // The feature tracks, independent of CVO, catch a registration stuck near a wrong guess; a
+  // prior too unsure to start from still vetoes (a fast jump tracks few corners, and a wrong
+  // small motion can score a fair cosine).
+  if (priorJudges(frame.prior)) {
     // The tracks' points are the previous frame's: the registration's motion over this step.
     const Eigen::Isometry3d prior_from_current =
         pose_.inverse() * reference_pose_ * a.result.transform;

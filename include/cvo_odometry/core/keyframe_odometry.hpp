@@ -141,6 +141,8 @@ class KeyframeOdometry {
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
                      std::vector<Guess>* retries) const;
   bool priorConfident(const std::optional<MotionPrior>& prior) const;
+  // Enough inliers to contradict a registration, even at a ratio too low to be a guess.
+  bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
   double referenceSelfProduct(double ell);
   void checkStamp(double stamp) const;
