@@ -42,7 +42,8 @@ void CvoParams::validate() const {
     requirePositive(color_sigma, "color_sigma");
   }
   if (use_semantics) {
-    requirePositive(semantic_ell, "semantic_ell");
+    require(semantic_cross_weight >= 0.0 && semantic_cross_weight <= 1.0,
+            "semantic_cross_weight must be in [0, 1]");
     requirePositive(semantic_sigma, "semantic_sigma");
   }
   // The largest possible pair weight must clear the threshold, or no pair is ever retained.

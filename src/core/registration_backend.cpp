@@ -15,7 +15,7 @@ kernels::KernelConstants makeKernelConstants(const CvoParams& params, int semant
   k.use_color = params.use_color ? 1 : 0;
   k.color_inv_ell2 = static_cast<float>(1.0 / (params.color_ell * params.color_ell));
   k.semantic_classes = params.use_semantics ? semantic_classes : 0;
-  k.semantic_inv_ell2 = static_cast<float>(1.0 / (params.semantic_ell * params.semantic_ell));
+  k.semantic_cross_weight = static_cast<float>(params.semantic_cross_weight);
   return k;
 }
 

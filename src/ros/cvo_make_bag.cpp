@@ -1,7 +1,8 @@
 // cvo_make_bag: a TUM RGB-D or KITTI odometry folder as a rosbag with the nodelet's topics, so the
 // public datasets replay like a live camera.
 //   TUM:   <ns>/rgb/image_rect_color (bgr8, rgb time), <ns>/rgb/camera_info,
-//          <ns>/depth_registered/image_rect (32FC1 metres, depth time)
+//          <ns>/depth_registered/image_rect (32FC1 metres, depth time),
+//          with --segmentation DIR <ns>/segmentation/image (mono8/mono16 class ids, rgb time)
 //   KITTI: <ns>/left/image_rect, <ns>/right/image_rect (mono8), <ns>/left|right/camera_info;
 //          stamps are times.txt + 1 s (ROS time 0 means "no stamp"; --gt-out writes the ground
 //          truth at the bag's stamps)
@@ -21,6 +22,7 @@
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
+#include "cvo_odometry/tools/tool_options.hpp"
 
 namespace {
 
@@ -31,7 +33,9 @@ const char* kUsage =
     "  --base-frame NAME  the frame /tf_static puts the camera in (base_link)\n"
     "  --gt-out FILE      ground truth (TUM format) at the bag's stamps, for cvo_evaluate\n"
     "  --first N --last N frame range\n"
-    "  --stride N         every N-th frame of the range (larger motions per frame)\n";
+    "  --stride N         every N-th frame of the range (larger motions per frame)\n"
+    "  --segmentation DIR TUM: each colour image's class ids (DIR/<rgb path> or DIR/<file name>,\n"
+    "                     8 or 16 bit, e.g. from cvo_make_labels) on <ns>/segmentation/image\n";
 
 sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
                                    const std_msgs::Header& header) {
@@ -73,7 +77,7 @@ int main(int argc, char** argv) {
   try {
     const cvo::CommandLine cli(argc, argv,
                                {"tum", "kitti", "camera", "out", "ns", "frame-id", "base-frame",
-                                "gt-out", "first", "last", "stride"},
+                                "gt-out", "first", "last", "stride", "segmentation"},
                                {"help"});
     if (cli.has("help") || (!cli.has("tum") && !cli.has("kitti"))) {
       std::cout << kUsage;
@@ -86,6 +90,10 @@ int main(int argc, char** argv) {
     const std::string base_frame = cli.get("base-frame", "base_link");
     std::size_t written = 0;
     cvo::Trajectory ground_truth;  // at the bag's stamps
+    const std::string segmentation = cli.get("segmentation");
+    if (!segmentation.empty() && !cli.has("tum")) {
+      throw std::invalid_argument("--segmentation: TUM only (the stereo nodelet takes no labels)");
+    }
     if (cli.has("tum")) {
       const cvo::TumSequence sequence(cli.get("tum"));
       const std::string gt_path = cli.get("tum") + "/groundtruth.txt";
@@ -106,6 +114,19 @@ int main(int argc, char** argv) {
         bag.write(ns + "/rgb/image_rect_color", header.stamp,
                   imageMsg(image, sensor_msgs::image_encodings::BGR8, header));
         bag.write(ns + "/rgb/camera_info", header.stamp, cameraInfo(K, 0.0, header));
+        if (!segmentation.empty()) {
+          const cv::Mat labels =
+              cvo::readSegmentation(segmentation, f.rgb_path.substr(sequence.folder().size() + 1));
+          if (labels.channels() != 1 || (labels.depth() != CV_8U && labels.depth() != CV_16U)) {
+            throw std::invalid_argument("--segmentation: " + f.rgb_path +
+                                        "'s labels are not 8 or 16-bit class ids");
+          }
+          bag.write(ns + "/segmentation/image", header.stamp,
+                    imageMsg(labels,
+                             labels.depth() == CV_8U ? sensor_msgs::image_encodings::MONO8
+                                                     : sensor_msgs::image_encodings::MONO16,
+                             header));
+        }
         header.stamp = ros::Time(f.depth_stamp);
         const cv::Mat metres = cvo::depthToMetres(depth, 5000.0, 0.0, 1e9);
         bag.write(ns + "/depth_registered/image_rect", header.stamp,

@@ -51,20 +51,6 @@ std::string datasetPath(const std::string& folder, const std::string& path) {
   return path.empty() || path.front() == '/' ? path : folder + "/" + path;
 }
 
-// The segmentation image of a frame: DIR/<colour path below the dataset folder>, else
-// DIR/<colour file name>; a missing one is an error naming both.
-cv::Mat readSegmentation(const std::string& dir, const std::string& colour_relative) {
-  const std::string name = colour_relative.substr(colour_relative.find_last_of('/') + 1);
-  for (const std::string& candidate : {dir + "/" + colour_relative, dir + "/" + name}) {
-    if (!fileExists(candidate)) continue;
-    cv::Mat labels = cv::imread(candidate, cv::IMREAD_UNCHANGED);
-    if (labels.empty()) throw std::runtime_error("cannot read segmentation '" + candidate + "'");
-    return labels;
-  }
-  throw std::runtime_error("no segmentation image for '" + colour_relative + "': neither " + dir +
-                           "/" + colour_relative + " nor " + dir + "/" + name);
-}
-
 // fr1, fr2, fr3 or numbers; without a size in `name`, the size of the image `sample`.
 PinholeIntrinsics cameraIntrinsics(const std::string& name, const cv::Mat& sample) {
   if (name == "fr1" || name == "fr2" || name == "fr3") {
@@ -201,6 +187,18 @@ SequenceInput openSequence(const CommandLine& cli) {
     return CameraFrame(frame);
   };
   return input;
+}
+
+cv::Mat readSegmentation(const std::string& dir, const std::string& colour_relative) {
+  const std::string name = colour_relative.substr(colour_relative.find_last_of('/') + 1);
+  for (const std::string& candidate : {dir + "/" + colour_relative, dir + "/" + name}) {
+    if (!fileExists(candidate)) continue;
+    cv::Mat labels = cv::imread(candidate, cv::IMREAD_UNCHANGED);
+    if (labels.empty()) throw std::runtime_error("cannot read segmentation '" + candidate + "'");
+    return labels;
+  }
+  throw std::runtime_error("no segmentation image for '" + colour_relative + "': neither " + dir +
+                           "/" + colour_relative + " nor " + dir + "/" + name);
 }
 
 LabeledCloud buildCloud(const OdometrySettings& settings, const CameraFrame& frame) {

@@ -132,7 +132,7 @@ Problem problemOf(const ParityCase& c) {
   p.first_frame = true;
   if (c.classes) {
     p.params.use_semantics = true;
-    p.params.semantic_ell = 0.3;
+    p.params.semantic_cross_weight = 0.5;  // cross-class pairs count too, at half weight
     p.params.semantic_sigma = 1.0;
   }
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
@@ -204,7 +204,9 @@ class RegistrationParity : public ::testing::TestWithParam<DeviceAndCase> {
 };
 
 // The device's registration against the CPU's: transform within 1e-4 rad / 0.1 mm, indicator
-// within 1e-5 relative, iterations within 1 (but see freeRunningCases).
+// within 5e-5 relative (it is taken at the two final poses, which differ by float summation
+// order; LockstepParity compares evaluations at one pose), iterations within 1 (but see
+// freeRunningCases).
 TEST_P(RegistrationParity, SameRegistrationAsTheCpu) {
   const auto& [which, c] = GetParam();
   const Problem p = problemOf(c);
@@ -217,7 +219,7 @@ TEST_P(RegistrationParity, SameRegistrationAsTheCpu) {
   const Eigen::Isometry3d diff = a.transform.inverse() * b.transform;
   EXPECT_LT(cvo::lie::rotationAngle(diff.linear()), 1e-4);
   EXPECT_LT(diff.translation().norm(), 1e-4);
-  EXPECT_NEAR(b.report.indicator_after, a.report.indicator_after, 1e-5 * a.report.indicator_after);
+  EXPECT_NEAR(b.report.indicator_after, a.report.indicator_after, 5e-5 * a.report.indicator_after);
   // Float sums in another order may move the last step across eps_2 one iteration apart.
   EXPECT_LE(std::abs(a.report.iterations - b.report.iterations), c.iteration_slack)
       << a.report.iterations << " vs " << b.report.iterations;

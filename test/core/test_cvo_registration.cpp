@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "cvo_odometry/core/backend_factory.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
@@ -9,6 +10,7 @@
 #include "cvo_odometry/core/failover_backend.hpp"
 #include "cvo_odometry/core/fault_injection_backend.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/pair_kernels.hpp"
 #include "synthetic_scene.hpp"
 
 using cvo::CvoParams;
@@ -28,6 +30,7 @@ CvoParams syntheticParams(bool color) {
   p.ell_min = 0.05;
   p.color_ell = 0.15;
   p.ell_first_frame = 0.5;  // identity guess, up to 15 deg / 0.3 m away
+  p.sp_ratio = 0.0;         // the paper's absolute sp_thres 0.003
   return p;
 }
 
@@ -178,8 +181,7 @@ TEST(CvoAmbiguity, SemanticsFixASlideAlongAPlaneThatGeometryCannot) {
   const Eigen::Isometry3d truth = pose(0, 0, 0, 0.06, 0.0, 0.0);
   CvoParams params = syntheticParams(false);
   params.ell_init = 0.1;
-  params.use_semantics = true;
-  params.semantic_ell = 0.3;
+  params.use_semantics = true;  // semantic_cross_weight 0: a class gate
   params.semantic_sigma = 1.0;
   const LabeledCloud target = cvo_test::texturedPlane(6000, 30, 0.0f, 1.6f, false, 3);
   const LabeledCloud source = cvo_test::texturedPlane(2500, 31, 0.4f, 1.2f, false, 3)
@@ -192,6 +194,71 @@ TEST(CvoAmbiguity, SemanticsFixASlideAlongAPlaneThatGeometryCannot) {
   CvoRegistration geometry_only(params);
   const auto plain = geometry_only.align(target, source, Eigen::Isometry3d::Identity());
   EXPECT_GT(std::abs((plain.transform.translation() - truth.translation()).x()), 0.04);
+}
+
+// The same cloud with every class vector blended towards uniform: informativeness 0 carries no
+// class information, 1 the hard labels.
+LabeledCloud withInformativeness(const LabeledCloud& cloud, float informativeness) {
+  const int classes = cloud.semanticClasses();
+  LabeledCloud out(cloud.hasColor(), classes);
+  std::vector<float> p(static_cast<std::size_t>(classes));
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (int k = 0; k < classes; ++k)
+      p[k] = (1.0f - informativeness) / classes + informativeness * cloud.semantics(i)[k];
+    out.add(cloud.position(i), cloud.hasColor() ? cloud.color(i) : nullptr, p.data());
+  }
+  return out;
+}
+
+TEST(SemanticKernel, HardLabelsGateOrWeighAndProbabilitiesAreSoft) {
+  using cvo::kernels::semanticDistance2;
+  const float a[3] = {1, 0, 0}, b[3] = {0, 1, 0}, uniform[3] = {1.f / 3, 1.f / 3, 1.f / 3};
+  EXPECT_NEAR(semanticDistance2(a, a, 3, 0.0f), 0.0f, 1e-6f) << "one class: weight 1";
+  EXPECT_GE(semanticDistance2(a, b, 3, 0.0f), cvo::kernels::kSemanticGateDistance2)
+      << "cross weight 0: a gate";
+  EXPECT_NEAR(std::exp(-0.5f * semanticDistance2(a, b, 3, 0.37f)), 0.37f, 1e-5f)
+      << "across classes: the stated weight";
+  EXPECT_NEAR(semanticDistance2(uniform, a, 3, 0.0f), -2.0f * std::log(1.0f / std::sqrt(3.0f)),
+              1e-5f);
+  EXPECT_NEAR(semanticDistance2(uniform, uniform, 3, 0.0f), 0.0f, 1e-6f)
+      << "no information weighs like semantics off";
+  // Sharpening two different classes' vectors lowers their weight continuously.
+  float previous = -1.0f;
+  for (float informativeness : {0.0f, 0.25f, 0.5f, 0.75f, 0.95f}) {
+    float p[3], q[3];
+    for (int k = 0; k < 3; ++k) {
+      p[k] = (1.0f - informativeness) / 3 + informativeness * a[k];
+      q[k] = (1.0f - informativeness) / 3 + informativeness * b[k];
+    }
+    const float d2 = semanticDistance2(p, q, 3, 0.0f);
+    EXPECT_GT(d2, previous) << informativeness;
+    previous = d2;
+  }
+}
+
+// Class stripes 10 cm wide across a plane that geometry cannot pin in x: the error in x
+// falls as the labels go from uniform (geometry alone) to hard.
+TEST(SemanticKernel, ThePoseImprovesAsLabelsBecomeInformative) {
+  const Eigen::Isometry3d truth = pose(0, 0, 0, 0.06, 0.0, 0.0);
+  CvoParams params = syntheticParams(false);
+  params.ell_init = 0.1;
+  params.use_semantics = true;
+  params.semantic_sigma = 1.0;
+  const LabeledCloud target = cvo_test::texturedPlane(6000, 30, 0.0f, 1.6f, false, 3);
+  const LabeledCloud source = cvo_test::texturedPlane(2500, 31, 0.4f, 1.2f, false, 3)
+                                  .transformed(truth.inverse().cast<float>());
+  std::vector<double> errors;
+  for (float informativeness : {0.0f, 0.5f, 0.8f, 0.9f, 1.0f}) {
+    CvoRegistration registration(params);
+    const auto result = registration.align(withInformativeness(target, informativeness),
+                                           withInformativeness(source, informativeness),
+                                           Eigen::Isometry3d::Identity());
+    errors.push_back(std::abs((result.transform.translation() - truth.translation()).x()));
+  }
+  EXPECT_GT(errors.front(), 0.04) << "uniform labels: geometry alone, stuck";
+  EXPECT_LT(errors.back(), 1e-2) << "hard labels pin x";
+  for (std::size_t k = 1; k < errors.size(); ++k)
+    EXPECT_LE(errors[k], errors[k - 1] + 1e-3) << "informativeness step " << k;
 }
 
 TEST(CvoRegistration, ResultsAreIdenticalRunToRunAndAcrossThreadCounts) {
@@ -267,8 +334,7 @@ TEST(CvoRegistration, BadInputGivesClearErrors) {
 
 TEST(CvoParams, TheRetainThresholdFollowsTheEnabledKernels) {
   CvoParams p;
-  EXPECT_DOUBLE_EQ(p.retainThreshold(), p.sp_thres) << "the paper's absolute form by default";
-  p.sp_ratio = 0.3;  // sigma 0.1: the paper's sp_thres 0.003 with geometry only
+  EXPECT_DOUBLE_EQ(p.sp_ratio, 0.3);  // sigma 0.1: the paper's sp_thres 0.003 with geometry only
   EXPECT_NEAR(p.retainThreshold(), 0.003, 1e-12);
   p.use_color = true;  // color_sigma 0.6: largest product 0.0036, threshold 0.00108
   EXPECT_NEAR(p.retainThreshold(), 0.3 * 0.0036, 1e-12);
@@ -297,6 +363,7 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   p.ell_min = 0.5;
   EXPECT_NE(message(p).find("ell_min (0.500000) > ell_init (0.150000)"), std::string::npos);
   p = CvoParams();
+  p.sp_ratio = 0.0;
   p.sp_thres = 0.02;  // s^2 = 0.01
   EXPECT_NE(message(p).find("no pair could count"), std::string::npos);
   EXPECT_NE(message(p).find("set sp_ratio"), std::string::npos) << "says what to change";

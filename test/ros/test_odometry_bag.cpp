@@ -8,7 +8,9 @@
 // (the rosbag player's name, default /player), camera_frame (base_link <- camera from TF turns
 // the base poses into the camera's, which the ground truth has), runner_trajectory
 // (cvo_run_sequence's trajectory of the same frames: the nodelet must give the same poses,
-// within runner_tolerance_m).
+// within runner_tolerance_m), label_classes and ignored_class (segmentation on: the current
+// debug cloud carries a label of fewer classes per point, more than one class, never the ignored
+// one).
 // Nothing here depends on the machine's speed: the bag is played paused (play_bag.launch
 // start_paused) and resumed by this node only once it receives the nodelet's output, and paced
 // by the nodelet's indicator (play_bag.launch pace), so no frame is missed or dropped however
@@ -17,8 +19,12 @@
 
 #include <mutex>
 
+#include <set>
+
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -35,6 +41,7 @@ struct Collected {
   std::mutex mutex;
   std::vector<nav_msgs::Odometry> odometry;
   std::vector<cvo_odometry::CvoIndicator> indicators;
+  sensor_msgs::PointCloud2 last_cloud;  // cloud/current
 };
 
 Eigen::Isometry3d poseOf(const nav_msgs::Odometry& msg) {
@@ -76,6 +83,17 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
         std::lock_guard<std::mutex> lock(collected.mutex);
         collected.indicators.push_back(*msg);
       });
+  int label_classes = 0, ignored_class = -1;
+  pnh.param("label_classes", label_classes, 0);
+  pnh.param("ignored_class", ignored_class, -1);
+  ros::Subscriber cloud_sub;
+  if (label_classes > 0) {
+    cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+        "cloud/current", 5, [&](const sensor_msgs::PointCloud2::ConstPtr& msg) {
+          std::lock_guard<std::mutex> lock(collected.mutex);
+          collected.last_cloud = *msg;
+        });
+  }
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
 
@@ -127,6 +145,17 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     EXPECT_LE(indicator.cosine, 1.0 + 1e-9);
     EXPECT_GT(indicator.source_points, 1000u);
     EXPECT_GT(indicator.target_points, 1000u);
+  }
+  if (label_classes > 0) {
+    const auto& cloud = collected.last_cloud;
+    ASSERT_GT(cloud.width * cloud.height, 1000u) << "no current cloud received";
+    std::set<int> classes;
+    for (sensor_msgs::PointCloud2ConstIterator<std::uint16_t> label(cloud, "label");
+         label != label.end(); ++label)
+      classes.insert(*label);
+    EXPECT_GT(classes.size(), 1u) << "the labels of more than one class reach the cloud";
+    EXPECT_LT(*classes.rbegin(), label_classes);
+    EXPECT_EQ(classes.count(ignored_class), 0u) << "ignore_classes drops class " << ignored_class;
   }
   const auto& last = collected.odometry.back();
   EXPECT_EQ(last.header.frame_id, "odom");

@@ -50,17 +50,22 @@ struct CvoParams {
   // A pair counts when its kernel product a_ij exceeds the retain threshold: with sp_ratio > 0,
   // sp_ratio times the largest product the enabled kernels can give (sigma^2 color_sigma^2
   // semantic_sigma^2), so that switching a kernel on or changing an amplitude keeps the same
-  // neighbourhood; with sp_ratio 0 (default), the paper's absolute sp_thres.
+  // neighbourhood (default 0.3: the paper's 0.003 with geometry only); with sp_ratio 0, the
+  // paper's absolute sp_thres.
   // retainThreshold() is the one conversion.
-  double sp_ratio = 0.0;
+  double sp_ratio = 0.3;
   double sp_thres = 0.003;
 
-  // Appearance kernels s_V^2 exp(-|u - v|^2 / (2 ell_V^2)), multiplied into the pair weight.
+  // Appearance kernels, multiplied into the pair weight: colour s_c^2 exp(-|c - c'|^2 / (2
+  // ell_c^2)).
   bool use_color = false;
   double color_ell = 0.3;
   double color_sigma = 0.6;
   bool use_semantics = false;
-  double semantic_ell = 0.1;
+  // Semantic factor s_s^2 (w + (1 - w) cos(p, q)) of class-probability vectors p, q: with hard
+  // labels 1 within a class and w across (the paper's exp(-1 / l_s^2): l_s 0.1 gives 0, 1 gives
+  // 0.37); probabilities are soft, a uniform vector weighs like semantics off.
+  double semantic_cross_weight = 0.0;
   double semantic_sigma = 0.8;
 
   // Reference annealing: when the retained-pair ratio of the last `indicator_window` iterations is
@@ -126,8 +131,9 @@ struct CvoParams {
   double min_prior_inlier_ratio = 0.3;
   double guess_disagreement_translation = 0.05;  // m
   double guess_disagreement_rotation = 2.0;      // deg
-  // A confident prior (min_prior_inliers, min_prior_inlier_ratio) judges every registration:
-  // at least min_track_agreement of its inliers within track_agreement_px.
+  // A prior with min_prior_inliers inliers, whatever their ratio, judges every registration: at
+  // least min_track_agreement of its inliers within track_agreement_px. Only a confident one
+  // (min_prior_inlier_ratio too) is a guess and relaxes the cosine.
   double track_agreement_px = 10.0;
   double min_track_agreement = 0.5;
   // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.

@@ -36,7 +36,10 @@ void visitSettings(CvoParams& p, V&& v) {
   v(SettingInfo{"use_semantics", "kernels",
                 "semantic kernel on (needs segmentation images with semantic_classes)"},
     p.use_semantics);
-  v(SettingInfo{"semantic_ell", "kernels", "semantic lengthscale", 0.01, 5.0}, p.semantic_ell);
+  v(SettingInfo{"semantic_cross_weight", "kernels",
+                "weight of a pair of different classes against one of the same class (0: a gate)",
+                0.0, 1.0},
+    p.semantic_cross_weight);
   v(SettingInfo{"semantic_sigma", "kernels", "semantic kernel amplitude", 0.01, 10.0},
     p.semantic_sigma);
   // Step method and schedule
@@ -140,10 +143,10 @@ void visitSettings(CvoParams& p, V&& v) {
                 "drop the motion history before every frame (as after a restart; for tests)"},
     p.forget_motion);
   v(SettingInfo{"min_prior_inliers", "guess",
-                "the feature prior is confident with this many inliers", 4, 100000},
+                "the feature prior's tracks judge registrations with this many inliers", 4, 100000},
     p.min_prior_inliers);
   v(SettingInfo{"min_prior_inlier_ratio", "guess",
-                "... and at least this fraction of its tracks as inliers", 0.0, 1.0},
+                "... and it is the guess with this fraction of its tracks as inliers", 0.0, 1.0},
     p.min_prior_inlier_ratio);
   v(SettingInfo{"guess_disagreement_translation", "guess",
                 "prior and constant velocity further apart than this (m) are both tried", 0.001,
@@ -156,12 +159,10 @@ void visitSettings(CvoParams& p, V&& v) {
                 "a feature track agrees with a registration within this reprojection error (px)",
                 0.1, 100.0},
     p.track_agreement_px);
-  v(
-      SettingInfo{
-          "min_track_agreement", "tracking",
-          "a confident prior trusts a registration only if this fraction of its inliers agrees",
-          0.0, 1.0},
-      p.min_track_agreement);
+  v(SettingInfo{"min_track_agreement", "tracking",
+                "a registration the tracks judge is trusted only if this fraction of them agrees",
+                0.0, 1.0},
+    p.min_track_agreement);
   v(SettingInfo{"tracked_cosine_ratio", "tracking",
                 "a registration the tracks judge needs a cosine of only this fraction of "
                 "min_cosine",

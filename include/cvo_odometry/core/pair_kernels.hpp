@@ -2,7 +2,9 @@
 // (compiled as __host__ __device__ by nvcc). No Eigen or STL here: plain floats and doubles.
 //
 // Pair weight of target point x_i and moved source point z_j:
-//   a_ij = s^2 exp(-|x_i - z_j|^2 / (2 ell^2)) * prod_V s_V^2 exp(-|u_i - v_j|^2 / (2 ell_V^2))
+//   a_ij = s^2 exp(-|x_i - z_j|^2 / (2 ell^2)) * s_c^2 exp(-|c_i - c_j|^2 / (2 ell_c^2))
+//          * s_s^2 (w + (1 - w) cos(p_i, p_j))
+// (colour c, class probabilities p, cross-class weight w; a factor only when its kernel is on)
 // and the pair counts (is "retained") only when a_ij > sp_thres.
 #pragma once
 
@@ -23,10 +25,10 @@ constexpr int kColorDim = 5;
 struct KernelConstants {
   float max_weight;  // s^2 * s_c^2 * s_s^2 over the kernels in use
   float sp_thres;
-  int use_color;            // 0 or 1
-  float color_inv_ell2;     // 1 / ell_c^2
-  int semantic_classes;     // 0: semantics off
-  float semantic_inv_ell2;  // 1 / ell_s^2
+  int use_color;                // 0 or 1
+  float color_inv_ell2;         // 1 / ell_c^2
+  int semantic_classes;         // 0: semantics off
+  float semantic_cross_weight;  // w: two points of different classes weigh w of a same-class pair
 };
 
 // Sums over retained pairs with the source moved by the current estimate: enough for F, its
@@ -166,15 +168,34 @@ CVO_HOST_DEVICE inline float squaredDistance(const float* a, const float* b, int
   return sum;
 }
 
-// Scaled appearance distance sum_V |u - v|^2 / ell_V^2 (0 with no appearance kernel). Colour
-// and semantic pointers may be null when that kernel is off.
+// The semantic factor w + (1 - w) cos(p, q) of two class-probability vectors, as the scaled
+// distance -2 ln(factor) that adds to the other kernels' exponents. Hard (one-hot) labels: 0 for
+// one class, -2 ln w across classes (a gate at w = 0); probabilities in between; an
+// uninformative (uniform) vector matches everything, as if semantics were off.
+constexpr float kSemanticGateDistance2 = 200.0f;  // exp(-100): never retained
+CVO_HOST_DEVICE inline float semanticDistance2(const float* p, const float* q, int classes,
+                                               float cross_weight) {
+  float dot = 0.0f, pp = 0.0f, qq = 0.0f;
+  for (int k = 0; k < classes; ++k) {
+    dot += p[k] * q[k];
+    pp += p[k] * p[k];
+    qq += q[k] * q[k];
+  }
+  const float cosine = dot > 0.0f ? fminf(dot / sqrtf(pp * qq), 1.0f) : 0.0f;
+  const float factor = cross_weight + (1.0f - cross_weight) * cosine;
+  return factor > 1e-30f ? fminf(-2.0f * logf(factor), kSemanticGateDistance2)
+                         : kSemanticGateDistance2;
+}
+
+// Scaled appearance distance: |c - c'|^2 / ell_c^2 plus the semantic distance (0 with no
+// appearance kernel). Colour and semantic pointers may be null when that kernel is off.
 CVO_HOST_DEVICE inline float appearanceDistance2(const KernelConstants& k, const float* color_x,
                                                  const float* color_z, const float* semantic_x,
                                                  const float* semantic_z) {
   float d2 = 0.0f;
   if (k.use_color) d2 += squaredDistance(color_x, color_z, kColorDim) * k.color_inv_ell2;
   if (k.semantic_classes > 0) {
-    d2 += squaredDistance(semantic_x, semantic_z, k.semantic_classes) * k.semantic_inv_ell2;
+    d2 += semanticDistance2(semantic_x, semantic_z, k.semantic_classes, k.semantic_cross_weight);
   }
   return d2;
 }

@@ -42,6 +42,10 @@ struct SequenceInput {
 // dataset folder, else its file name; a missing one is an error.
 SequenceInput openSequence(const CommandLine& cli);
 
+// The segmentation image of a frame: DIR/<colour path below the dataset folder>, else
+// DIR/<colour file name>; a missing or unreadable one is an error naming both.
+cv::Mat readSegmentation(const std::string& dir, const std::string& colour_relative);
+
 // The labeled cloud of one frame by the front end of `settings`.
 LabeledCloud buildCloud(const OdometrySettings& settings, const CameraFrame& frame);
 
