@@ -37,6 +37,7 @@ void CvoParams::validate() const {
   require(ell_min <= ell_init, "ell_min (" + std::to_string(ell_min) + ") > ell_init (" +
                                    std::to_string(ell_init) + ")");
   require(ell_min <= ell_first_frame, "ell_min > ell_first_frame");
+  requirePositive(ell_prior, "ell_prior");  // below ell_min: ell_min (no annealing)
   if (use_color) {
     requirePositive(color_ell, "color_ell");
     requirePositive(color_sigma, "color_sigma");

@@ -56,8 +56,8 @@ void CvoRegistration::checkInputs(const LabeledCloud& target, const LabeledCloud
 }
 
 RegistrationResult CvoRegistration::align(const LabeledCloud& target, const LabeledCloud& source,
-                                          const Eigen::Isometry3d& initial_guess,
-                                          bool first_frame) {
+                                          const Eigen::Isometry3d& initial_guess, bool first_frame,
+                                          double initial_lengthscale) {
   const auto start = std::chrono::steady_clock::now();
   checkInputs(target, source);
   if (!initial_guess.matrix().allFinite()) {
@@ -71,7 +71,9 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   RegistrationResult result;
   RegistrationReport& report = result.report;
   report.backend = backend_->name();
-  const double ell = first_frame ? params_.ell_first_frame : params_.ell_init;
+  const double ell = initial_lengthscale > 0.0 ? std::max(initial_lengthscale, params_.ell_min)
+                     : first_frame             ? params_.ell_first_frame
+                                               : params_.ell_init;
   report.initial_lengthscale = ell;
   const Eigen::Isometry3d guess = lie::orthonormalized(initial_guess);
   if (params_.step_method == StepMethod::kProcrustes) {

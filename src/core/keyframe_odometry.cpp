@@ -160,9 +160,11 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   const CvoParams& p = params();
   Attempt a;
   a.guess = guess.kind;
-  // Without a motion guess the registration needs the wide first-frame lengthscale.
+  // Without a motion guess the registration needs the wide first-frame lengthscale; a confident
+  // feature prior is millimetres off and needs no wide basin.
   a.result =
-      registration_.align(*reference_, cloud, guess.motion, guess.kind == GuessKind::kIdentity);
+      registration_.align(*reference_, cloud, guess.motion, guess.kind == GuessKind::kIdentity,
+                          guess.kind == GuessKind::kFeatures ? p.ell_prior : 0.0);
   const RegistrationReport& report = a.result.report;
   // cos = F_XZ / sqrt(F_XX F_ZZ). F_XZ comes with the report (the indicator times
   // sqrt(|X||Z|)); F_XX is cached per reference. No pairs in reach: nothing to take.

@@ -29,9 +29,11 @@ class CvoRegistration {
 
   // Throws std::invalid_argument for empty clouds, non-finite points or features the enabled
   // kernels need but the clouds lack. A registration that finds no pairs within the kernels'
-  // reach returns converged = false with the guess and says so in the message.
+  // reach returns converged = false with the guess and says so in the message. The annealing
+  // starts at `initial_lengthscale` when > 0, else at ell_first_frame or ell_init.
   RegistrationResult align(const LabeledCloud& target, const LabeledCloud& source,
-                           const Eigen::Isometry3d& initial_guess, bool first_frame = false);
+                           const Eigen::Isometry3d& initial_guess, bool first_frame = false,
+                           double initial_lengthscale = 0.0);
 
   // F(T) at lengthscale `ell` (sparse sum over retained pairs).
   double innerProduct(const LabeledCloud& target, const LabeledCloud& source,

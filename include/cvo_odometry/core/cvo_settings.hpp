@@ -20,6 +20,11 @@ void visitSettings(CvoParams& p, V&& v) {
                 "lengthscale of a registration without a motion guess (first frame, recovery) (m)",
                 0.005, 3.0},
     p.ell_first_frame);
+  v(SettingInfo{"ell_prior", "kernels",
+                "lengthscale of a registration from a confident feature prior (m): its guess is "
+                "within millimetres, no wide basin is needed",
+                0.002, 2.0},
+    p.ell_prior);
   v(SettingInfo{"sigma", "kernels", "geometric kernel amplitude s", 0.001, 10.0}, p.sigma);
   v(SettingInfo{"sp_ratio", "kernels",
                 "a pair counts only if its kernel product exceeds this fraction of the largest "
