@@ -46,15 +46,16 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
 namespace {
 
 template <typename T>
-void disparityRowsToMetres(const cv::Mat& disparity, float numerator, float scale, float min_depth,
-                           float max_depth, cv::Mat* metres) {
+void disparityRowsToMetres(const cv::Mat& disparity, float numerator, float scale, float offset,
+                           float min_depth, float max_depth, cv::Mat* metres) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int v = 0; v < disparity.rows; ++v) {
     const T* in = disparity.ptr<T>(v);
     auto* out = metres->ptr<float>(v);
     for (int u = 0; u < disparity.cols; ++u) {
       const float d = static_cast<float>(in[u]) * scale;
-      const float z = d > 0.0f && std::isfinite(d) ? numerator / d : nan;
+      const float z =
+          d > 0.0f && std::isfinite(d) && d + offset > 0.0f ? numerator / (d + offset) : nan;
       out[u] = z >= min_depth && z <= max_depth ? z : nan;
     }
   }
@@ -63,7 +64,8 @@ void disparityRowsToMetres(const cv::Mat& disparity, float numerator, float scal
 }  // namespace
 
 cv::Mat disparityToMetres(const cv::Mat& disparity, double focal_times_baseline,
-                          double disparity_scale, double min_depth, double max_depth) {
+                          double disparity_scale, double min_depth, double max_depth,
+                          double disparity_offset) {
   if (disparity.empty()) throw std::invalid_argument("disparity image is empty");
   if (disparity.channels() != 1) {
     throw std::invalid_argument("disparity image has " + std::to_string(disparity.channels()) +
@@ -77,20 +79,22 @@ cv::Mat disparityToMetres(const cv::Mat& disparity, double focal_times_baseline,
   cv::Mat metres(disparity.size(), CV_32FC1);
   const auto fb = static_cast<float>(focal_times_baseline);
   const auto scale = static_cast<float>(disparity_scale);
+  const auto offset = static_cast<float>(disparity_offset);
+  if (!std::isfinite(offset)) throw std::invalid_argument("disparity offset must be finite");
   const auto lo = static_cast<float>(min_depth);
   const auto hi = static_cast<float>(max_depth);
   switch (disparity.depth()) {
     case CV_32F:
-      disparityRowsToMetres<float>(disparity, fb, scale, lo, hi, &metres);
+      disparityRowsToMetres<float>(disparity, fb, scale, offset, lo, hi, &metres);
       break;
     case CV_16U:
-      disparityRowsToMetres<std::uint16_t>(disparity, fb, scale, lo, hi, &metres);
+      disparityRowsToMetres<std::uint16_t>(disparity, fb, scale, offset, lo, hi, &metres);
       break;
     case CV_16S:
-      disparityRowsToMetres<std::int16_t>(disparity, fb, scale, lo, hi, &metres);
+      disparityRowsToMetres<std::int16_t>(disparity, fb, scale, offset, lo, hi, &metres);
       break;
     case CV_8U:
-      disparityRowsToMetres<std::uint8_t>(disparity, fb, scale, lo, hi, &metres);
+      disparityRowsToMetres<std::uint8_t>(disparity, fb, scale, offset, lo, hi, &metres);
       break;
     default:
       throw std::invalid_argument("unsupported disparity image type " +

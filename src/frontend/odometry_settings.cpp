@@ -26,6 +26,7 @@ RgbdFrontendOptions OdometrySettings::rgbdOptions() const {
 StereoFrontendOptions OdometrySettings::stereoOptions() const {
   StereoFrontendOptions options;
   options.matcher = stereo;
+  options.disparity_offset = disparity_offset;
   options.cloud = cloudOptions();
   return options;
 }

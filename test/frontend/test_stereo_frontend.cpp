@@ -103,6 +103,44 @@ TEST(StereoFrontend, GivenDisparityGivesMetricDepthCroppedAndInRange) {
   }
 }
 
+// disparity_offset corrects a calibration: z = f b / (d + offset) where d is valid, and the
+// pixels without a disparity (0) stay without depth.
+TEST(StereoFrontend, DisparityOffsetShiftsEveryValidDisparity) {
+  const cv::Mat disparity = cv::imread(kPair + "/disparity.png", cv::IMREAD_UNCHANGED);
+  cvo::OdometrySettings settings = kittiSettings();
+  const cv::Mat plain = cvo::StereoCloudBuilder(settings.stereoOptions()).depth([&] {
+    cvo::StereoFrame frame;
+    frame.left = readGrey(kPair + "/left.png");
+    frame.disparity = disparity;
+    frame.intrinsics = pairIntrinsics();
+    frame.baseline = kPairBaseline;
+    return frame;
+  }());
+  settings.disparity_offset = 0.25;
+  cvo::StereoFrame frame;
+  frame.left = readGrey(kPair + "/left.png");
+  frame.disparity = disparity;
+  frame.intrinsics = pairIntrinsics();
+  frame.baseline = kPairBaseline;
+  const cv::Mat shifted = cvo::StereoCloudBuilder(settings.stereoOptions()).depth(frame);
+  const double fb = pairIntrinsics().fx * kPairBaseline;
+  std::size_t checked = 0;
+  for (int v = 0; v < disparity.rows; ++v) {
+    for (int u = 0; u < disparity.cols; ++u) {
+      const int d = disparity.at<std::uint8_t>(v, u);
+      const float z = shifted.at<float>(v, u);
+      if (d == 0) {
+        ASSERT_FALSE(std::isfinite(z)) << "no disparity, no depth";
+        continue;
+      }
+      if (!std::isfinite(plain.at<float>(v, u)) || !std::isfinite(z)) continue;  // out of range
+      ASSERT_NEAR(z, fb / (d + 0.25), 1e-4 * z);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100000u);
+}
+
 TEST(StereoFrontend, MatchedAndGivenDisparityGiveSimilarDepth) {
   cvo::StereoCloudBuilder builder(kittiSettings().stereoOptions());
   cvo::StereoFrame matched;

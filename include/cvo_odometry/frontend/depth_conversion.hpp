@@ -19,8 +19,10 @@ namespace cvo {
 // no valid depth. `disparity_scale` turns stored values into pixels: 1 for CV_32F pixels (as
 // stereo_msgs/DisparityImage carries) and plain 8-bit images, 1/16 for OpenCV's CV_16S fixed
 // point, 1/256 for KITTI's 16-bit PNGs. Non-positive, NaN and inf disparities and depths outside
-// [min_depth, max_depth] become NaN; other types throw std::invalid_argument.
+// [min_depth, max_depth] become NaN; other types throw std::invalid_argument. `disparity_offset`
+// (pixels) is added to every valid disparity first: a stereo calibration's correction.
 cv::Mat disparityToMetres(const cv::Mat& disparity, double focal_times_baseline,
-                          double disparity_scale, double min_depth, double max_depth);
+                          double disparity_scale, double min_depth, double max_depth,
+                          double disparity_offset = 0.0);
 
 }  // namespace cvo

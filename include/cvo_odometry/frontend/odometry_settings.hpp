@@ -18,7 +18,8 @@ struct OdometrySettings {
   CloudBuilderOptions cloud;
   StereoMatcherOptions stereo;
   FeatureTrackerOptions features;
-  double depth_scale = 1000.0;  // 16-bit depth units per metre
+  double depth_scale = 1000.0;    // 16-bit depth units per metre
+  double disparity_offset = 0.0;  // px added to every stereo disparity (README "Stereo scale")
 
   // Throws std::invalid_argument naming the first setting that makes no sense.
   void validate() const;
@@ -61,6 +62,10 @@ void visitSettings(OdometrySettings& s, V&& v) {
   v(SettingInfo{"num_disparities", "stereo", "SGBM disparity range (a multiple of 16)", 16, 1024},
     s.stereo.num_disparities);
   v(SettingInfo{"block_size", "stereo", "SGBM block size (odd)", 1, 21}, s.stereo.block_size);
+  v(SettingInfo{"disparity_offset", "stereo",
+                "pixels added to every disparity before depth: a stereo calibration's correction",
+                -5.0, 5.0},
+    s.disparity_offset);
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
   v(SettingInfo{"feature_prior", "features",

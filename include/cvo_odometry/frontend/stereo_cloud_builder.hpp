@@ -11,7 +11,8 @@ namespace cvo {
 
 struct StereoFrontendOptions {
   StereoMatcherOptions matcher;
-  double disparity_scale = 1.0;  // stored disparity value -> pixels (given disparity images)
+  double disparity_scale = 1.0;   // stored disparity value -> pixels (given disparity images)
+  double disparity_offset = 0.0;  // pixels added to every disparity (a calibration correction)
   CloudBuilderOptions cloud;
 };
 
