@@ -131,131 +131,154 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
   constants_ = makeKernelConstants(params, source.semanticClasses());
   constant_appearance_ = !constants_.use_color && constants_.semantic_classes == 0;
   cutoff2_ = retainedScaledDistance2(params);
-  candidates_valid_ = false;
   direct_ell_ = -1.0;
   ell_min_ = params.ell_min;
   grid_radius_ = -1.0f;
   // Blocks keep their storage across problems: no reallocation (and page faults) per level.
   blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
-  block_radius_.resize(blocks_.size());
+  for (Block& block : blocks_)
+    block.listed = false;
 }
 
-double CpuBackend::farthestPoint() const {
-  return block_radius_.empty() ? 0.0
-                               : *std::max_element(block_radius_.begin(), block_radius_.end());
+double CpuBackend::movedSinceListed(const Block& block, const Eigen::Isometry3d& T) {
+  // A point c + d (|d| <= spread) of the block moves by |M c - c| + |(R - I) d| under the
+  // motion M since the listing, and |(R - I) d| <= angle(R) |d|.
+  const Eigen::Isometry3d motion = T * block.pose.inverse();
+  return (motion * block.centre - block.centre).norm() +
+         lie::rotationAngle(motion.linear()) * block.spread;
 }
 
-double CpuBackend::movedSinceBuild(const Eigen::Isometry3d& T) const {
-  const Eigen::Isometry3d relative = T * built_pose_.inverse();
-  return lie::rotationAngle(relative.linear()) * built_radius_ + relative.translation().norm();
+bool CpuBackend::blockHolds(const Block& block, const Eigen::Isometry3d& T, double ell) {
+  return block.listed && ell == block.ell && movedSinceListed(block, T) < block.margin * ell;
 }
 
 bool CpuBackend::candidatesHold(const Eigen::Isometry3d& T, double ell) const {
-  return candidates_valid_ && ell == built_ell_ && movedSinceBuild(T) < margin_ * ell;
+  return std::all_of(blocks_.begin(), blocks_.end(),
+                     [&](const Block& block) { return blockHolds(block, T, ell); });
 }
 
 void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
-  if (candidatesHold(T, ell)) return;
-  if (candidates_valid_) {
-    const double moved = movedSinceBuild(T);
-    if (ell < built_ell_) {
-      const double margin = margin_ - moved / built_ell_;
+  // Each block decides for itself: points near the motion's axis keep their lists longest.
+  using Update = ListUpdate;
+  std::vector<Update>& updates = block_updates_;
+  std::vector<double>& margins = block_margins_;
+  updates.assign(blocks_.size(), Update::kBuild);
+  margins.assign(blocks_.size(), kSkin);
+  bool any_build = false, any_change = false;
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    const Block& block = blocks_[b];
+    if (blockHolds(block, T, ell)) {
+      updates[b] = Update::kKeep;
+      continue;
+    }
+    any_change = true;
+    if (block.listed && ell < block.ell) {
+      const double margin = block.margin - movedSinceListed(block, T) / block.ell;
       if (margin >= kMinMargin) {
-        refilterCandidates(T, ell, margin);
-        return;
+        updates[b] = Update::kRefilter;
+        margins[b] = margin;
+        continue;
       }
     }
+    any_build = true;
   }
-  buildCandidates(T, ell);
-}
-
-void CpuBackend::buildCandidates(const Eigen::Isometry3d& T, double ell) {
-  const double reach = std::sqrt(cutoff2_) + kSkin;  // scaled joint distance kept
+  if (!any_change) return;
+  const double reach = std::sqrt(cutoff2_) + kSkin;  // scaled joint distance a build keeps
   const float radius = static_cast<float>(reach * ell);
-  ensureGrid(radius);
+  if (any_build) ensureGrid(radius);
   float pose[12];
   toRowMajor3x4(T, pose);
+  pool_.run(blocks_.size(), [&](std::size_t b) {
+    if (updates[b] == Update::kKeep) return;
+    Block& block = blocks_[b];
+    if (updates[b] == Update::kRefilter) {
+      refilterBlock(b, pose, ell, margins[b]);
+    } else {
+      buildBlock(b, pose, ell, radius, reach);
+    }
+    block.listed = true;
+    block.pose = T;
+    block.ell = ell;
+    block.margin = margins[b];
+  });
+}
+
+void CpuBackend::Block::setExtent(const float* transformed, std::size_t count) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < count; ++k)
+    sum += Eigen::Vector3d(transformed[3 * k], transformed[3 * k + 1], transformed[3 * k + 2]);
+  centre = count ? Eigen::Vector3d(sum / static_cast<double>(count)) : sum;
+  spread = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3d z(transformed[3 * k], transformed[3 * k + 1], transformed[3 * k + 2]);
+    spread = std::max(spread, (z - centre).norm());
+  }
+}
+
+void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float radius,
+                            double reach) {
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
   const float reach2 = static_cast<float>(reach * reach);
   const float radius2 = radius * radius;
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
   const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
-  pool_.run(blocks_.size(), [&](std::size_t b) {
-    Block& block = blocks_[b];
-    double radius_max = 0.0;
-    block.offsets.assign(1, 0);
-    block.clear();
-    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
-    const std::size_t end = std::min(begin + kBlockSize, source_->size());
-    for (std::size_t j = begin; j < end; ++j) {
-      float z[3];
-      kernels::transformPoint(pose, src + 3 * j, z);
-      radius_max = std::max(
-          radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
-      if (constant_appearance_) {
-        // Geometry only: the radius test is the joint-distance test.
-        grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
-          for (std::uint32_t k = first; k < last; ++k) {
-            const float dx = xs[k] - z[0], dy = ys[k] - z[1], dz = zs[k] - z[2];
-            if (dx * dx + dy * dy + dz * dz <= radius2) block.push(xs[k], ys[k], zs[k]);
-          }
-        });
-      } else {
-        grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
-          const float appearance_d2 = appearanceDistance2(i, j);
-          if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
-          const float* x = tgt + 3 * i;
-          block.push(x[0], x[1], x[2], kernels::appearanceWeight(constants_, appearance_d2),
-                     appearance_d2);
-        });
-      }
-      block.offsets.push_back(static_cast<std::uint32_t>(block.size()));
+  Block& block = blocks_[b];
+  block.offsets.assign(1, 0);
+  block.clear();
+  const std::size_t begin = b * kBlockSize;
+  const std::size_t end = std::min(begin + kBlockSize, source_->size());
+  float transformed[3 * kBlockSize];
+  for (std::size_t j = begin; j < end; ++j) {
+    float* z = transformed + 3 * (j - begin);
+    kernels::transformPoint(pose, src + 3 * j, z);
+    if (constant_appearance_) {
+      // Geometry only: the radius test is the joint-distance test.
+      grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+        for (std::uint32_t k = first; k < last; ++k) {
+          const float dx = xs[k] - z[0], dy = ys[k] - z[1], dz = zs[k] - z[2];
+          if (dx * dx + dy * dy + dz * dz <= radius2) block.push(xs[k], ys[k], zs[k]);
+        }
+      });
+    } else {
+      grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
+        const float appearance_d2 = appearanceDistance2(i, j);
+        if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
+        const float* x = tgt + 3 * i;
+        block.push(x[0], x[1], x[2], kernels::appearanceWeight(constants_, appearance_d2),
+                   appearance_d2);
+      });
     }
-    block_radius_[b] = radius_max;
-  });
-  candidates_valid_ = true;
-  built_ell_ = ell;
-  margin_ = kSkin;
-  built_pose_ = T;
-  built_radius_ = farthestPoint();
+    block.offsets.push_back(static_cast<std::uint32_t>(block.size()));
+  }
+  block.setExtent(transformed, end - begin);
 }
 
-void CpuBackend::refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin) {
+void CpuBackend::refilterBlock(std::size_t b, const float* pose, double ell, double margin) {
   const double reach = std::sqrt(cutoff2_) + margin;
-  float pose[12];
-  toRowMajor3x4(T, pose);
   const float inv_ell2 = static_cast<float>(1.0 / (ell * ell));
   const float reach2 = static_cast<float>(reach * reach);
   const float* src = source_->positionData().data();
-  pool_.run(blocks_.size(), [&](std::size_t b) {
-    Block& block = blocks_[b];
-    double radius_max = 0.0;
-    const std::size_t begin = b * kBlockSize;
-    const std::size_t points = block.offsets.size() - 1;
-    std::uint32_t kept = 0, first = 0;
-    for (std::size_t k = 0; k < points; ++k) {
-      float z[3];
-      kernels::transformPoint(pose, src + 3 * (begin + k), z);
-      radius_max = std::max(
-          radius_max, std::sqrt(double(z[0]) * z[0] + double(z[1]) * z[1] + double(z[2]) * z[2]));
-      const std::uint32_t last = block.offsets[k + 1];
-      for (std::uint32_t c = first; c < last; ++c) {
-        const float x[3] = {block.x[c], block.y[c], block.z[c]};
-        const float d2 = kernels::squaredDistance(x, z, 3) * inv_ell2;
-        if (d2 + (constant_appearance_ ? 0.0f : block.appearance_d2[c]) >= reach2) continue;
-        block.move(c, kept++);
-      }
-      first = last;
-      block.offsets[k + 1] = kept;
+  Block& block = blocks_[b];
+  const std::size_t begin = b * kBlockSize;
+  const std::size_t points = block.offsets.size() - 1;
+  float transformed[3 * kBlockSize];
+  std::uint32_t kept = 0, first = 0;
+  for (std::size_t k = 0; k < points; ++k) {
+    float* z = transformed + 3 * k;
+    kernels::transformPoint(pose, src + 3 * (begin + k), z);
+    const std::uint32_t last = block.offsets[k + 1];
+    for (std::uint32_t c = first; c < last; ++c) {
+      const float x[3] = {block.x[c], block.y[c], block.z[c]};
+      const float d2 = kernels::squaredDistance(x, z, 3) * inv_ell2;
+      if (d2 + (constant_appearance_ ? 0.0f : block.appearance_d2[c]) >= reach2) continue;
+      block.move(c, kept++);
     }
-    block.resize(kept);
-    block_radius_[b] = radius_max;
-  });
-  built_ell_ = ell;
-  margin_ = margin;
-  built_pose_ = T;
-  built_radius_ = farthestPoint();
+    first = last;
+    block.offsets[k + 1] = kept;
+  }
+  block.resize(kept);
+  block.setExtent(transformed, points);
 }
 
 template <class Sums, class Fill>
@@ -330,12 +353,16 @@ kernels::MomentSums CpuBackend::sumFromGrid(const Eigen::Isometry3d& T, double e
   const float inv_two_ell2 = static_cast<float>(0.5 / (ell * ell));
   const float* src = source_->positionData().data();
   return sumBlocks<kernels::MomentSums>([&](std::size_t b, kernels::MomentSums& m) {
+    const Block& block = blocks_[b];
+    // A block whose list still holds sums it: the same pairs, fewer visited.
+    const bool listed = blockHolds(block, T, ell);
     const std::size_t begin = b * kBlockSize;
     const std::size_t end = std::min(begin + kBlockSize, source_->size());
     for (std::size_t j = begin; j < end; ++j) {
       float z[3];
       kernels::transformPoint(pose, src + 3 * j, z);
-      const kernels::PointSums sums = point_sums(j, z, radius, inv_two_ell2);
+      const kernels::PointSums sums = listed ? listSums(block, j - begin, z, inv_two_ell2)
+                                             : point_sums(j, z, radius, inv_two_ell2);
       if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
     }
   });
@@ -362,7 +389,6 @@ kernels::MomentSums CpuBackend::gridMoments(const Eigen::Isometry3d& T, double e
 }
 
 kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double ell) {
-  if (candidatesHold(T, ell)) return moments(T, ell);
   if (constant_appearance_) return gridMoments(T, ell);
   const float* tgt = target_->positionData().data();
   return sumFromGrid(T, ell, [&](std::size_t j, const float* z, float radius, float inv_two_ell2) {

@@ -22,7 +22,8 @@ class CpuBackend : public RegistrationBackend {
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
-  // From the candidate lists when they hold the pose, else straight from the grid (no lists).
+  // From the candidate lists of the blocks they hold for, the rest straight from the grid; the
+  // lists are left as they are.
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
@@ -35,6 +36,16 @@ class CpuBackend : public RegistrationBackend {
     std::vector<float> x, y, z;          // the target point, copied: unit-stride loads vectorise
     std::vector<float> appearance;       // s^2 times the appearance factors of the pair
     std::vector<float> appearance_d2;    // scaled appearance distance (pose independent)
+    // The list holds every pair within sqrt(cutoff) + margin (scaled) at `pose` and `ell`.
+    bool listed = false;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    double ell = 0.0;
+    double margin = 0.0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the points transformed by `pose`
+    double spread = 0.0;                               // their largest distance from centre
+
+    // centre and spread of `count` transformed points (x, y, z interleaved).
+    void setExtent(const float* transformed, std::size_t count);
 
     std::size_t size() const { return x.size(); }
     void clear();
@@ -53,21 +64,25 @@ class CpuBackend : public RegistrationBackend {
     void resize(std::size_t n);
   };
 
-  // True when the lists built at built_pose_ / built_ell_ still hold every pair at (T, ell).
+  // How far any point of the block can have moved between its listing pose and T.
+  static double movedSinceListed(const Block& block, const Eigen::Isometry3d& T);
+  // True when the block's list still holds every pair at (T, ell).
+  static bool blockHolds(const Block& block, const Eigen::Isometry3d& T, double ell);
+  // True when every block's list holds.
   bool candidatesHold(const Eigen::Isometry3d& T, double ell) const;
+  // Brings each block's list to (T, ell): kept while it holds, refiltered after a lengthscale
+  // decrease while the margin left allows, else built from the grid (a Verlet list per block).
   void ensureCandidates(const Eigen::Isometry3d& T, double ell);
-  // Candidates from the grid, kept when the scaled joint distance < sqrt(cutoff) + margin.
-  void buildCandidates(const Eigen::Isometry3d& T, double ell);
+  // Candidates of block b from the grid (cell `radius`), kept when the scaled joint distance
+  // < reach = sqrt(cutoff) + skin. `pose`: row-major 3x4.
+  void buildBlock(std::size_t b, const float* pose, double ell, float radius, double reach);
   // After a lengthscale decrease: the joint distance only grows as ell shrinks, so the new list
-  // is a filter of the old one, with the old margin less what the source moved since.
-  void refilterCandidates(const Eigen::Isometry3d& T, double ell, double margin);
-  double movedSinceBuild(const Eigen::Isometry3d& T) const;
-  // The largest block_radius_ (0 without blocks).
-  double farthestPoint() const;
+  // is a filter of the old one, with the old margin less what the block moved since.
+  void refilterBlock(std::size_t b, const float* pose, double ell, double margin);
   // The target's grid with this cell size (kept while the problem and size stay).
   void ensureGrid(float radius);
-  // Moments straight from the grid at the cut-off radius (no lists): point_sums(j, T z_j,
-  // radius, 1 / (2 ell^2)) gives each source point's sums.
+  // Moments at the cut-off radius: from a block's list where it holds, else straight from the
+  // grid, point_sums(j, T z_j, radius, 1 / (2 ell^2)) giving each source point's sums.
   template <class PointSumsAt>
   kernels::MomentSums sumFromGrid(const Eigen::Isometry3d& T, double ell, PointSumsAt&& point_sums);
   // Geometry only: the moments read from the grid's sorted ranges by the vectorised loop.
@@ -80,8 +95,7 @@ class CpuBackend : public RegistrationBackend {
   // The moment sums of point k of `block` (at z) over its candidate list.
   kernels::PointSums listSums(const Block& block, std::size_t k, const float* z,
                               float inv_two_ell2) const;
-  mutable BlockPool pool_;            // the blocks' threads (sums run from const members too)
-  std::vector<double> block_radius_;  // per block: the farthest transformed source point
+  mutable BlockPool pool_;  // the blocks' threads (sums run from const members too)
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   kernels::KernelConstants constants_{};
@@ -92,11 +106,10 @@ class CpuBackend : public RegistrationBackend {
   double direct_ell_ = -1.0;   // lengthscale of the last evaluation read from the grid
   double ell_min_ = 0.0;
   std::vector<Block> blocks_;
-  bool candidates_valid_ = false;
-  double built_ell_ = 0.0;
-  double margin_ = 0.0;  // lists hold every pair within sqrt(cutoff) + margin
-  Eigen::Isometry3d built_pose_ = Eigen::Isometry3d::Identity();
-  double built_radius_ = 0.0;  // largest |T_built z|: bounds how far a rotation moves a point
+  // ensureCandidates' per-block plan, kept to avoid an allocation a call.
+  enum class ListUpdate : unsigned char { kKeep, kRefilter, kBuild };
+  std::vector<ListUpdate> block_updates_;
+  std::vector<double> block_margins_;
 };
 
 }  // namespace cvo
