@@ -1,5 +1,10 @@
 // cvo_peers: the peers of the accuracy table on the same frames as cvo_run_sequence, frame to
 // frame with the previous motion as the guess, poses stamped like ours (TUM: depth time).
+//   --stride N: every N-th frame (frame k against frame k-N, like cvo_run_sequence --stride)
+//   --format tum|kitti: the trajectory written (default: the dataset's)
+// The time per frame (median, p95) runs from the decoded images to the pose, as the runner's
+// `total` does: PNG decoding is outside it; depth to metres, grey conversion, PCL's cloud and
+// voxel grid and the registration are inside.
 //   OpenCV (contrib rgbd): opencv_rgbd (photometric), opencv_icp, opencv_rgbdicp (TUM only)
 //   PCL: pcl_gicp, pcl_ndt on full depth clouds (TUM, 1 cm voxel grid) or on the stereo clouds
 //   our front end builds (KITTI)
@@ -7,6 +12,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
@@ -83,11 +89,17 @@ cv::Ptr<cv::rgbd::Odometry> openCvOdometry(const std::string& method,
 int main(int argc, char** argv) {
   try {
     auto names = cvo::sharedOptionNames();
-    names.insert(names.end(), {"method", "out", "voxel", "resolution"});
+    names.insert(names.end(), {"method", "out", "voxel", "resolution", "stride", "format"});
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help"});
     const std::string method = cli.require("method");
     const bool is_pcl = method.rfind("pcl_", 0) == 0;
     const cvo::SequenceInput input = cvo::openSequence(cli);
+    // PCL's clouds come from our front end with the settings given (--preset, --set, --NAME).
+    const cvo::OdometrySettings settings = cvo::settingsFrom(cli);
+    const int stride = cli.getInt("stride", 1);
+    if (stride < 1) throw std::invalid_argument("--stride must be >= 1");
+    const auto format =
+        cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format")) : input.trajectory_format;
     const bool tum = input.kind == "tum";
     // TUM: PCL on every valid depth pixel (then a voxel grid); KITTI: our stereo clouds.
     double voxel = cli.getDouble("voxel", tum ? 0.01 : 0.0);
@@ -109,15 +121,23 @@ int main(int argc, char** argv) {
     Eigen::Matrix4d pose = Eigen::Matrix4d::Identity(), motion = Eigen::Matrix4d::Identity();
     Cloud::Ptr previous_cloud;
     cv::Mat previous_grey, previous_depth;
-    for (std::size_t k = 0; k < input.stamps.size(); ++k) {
+    const auto step = static_cast<std::size_t>(stride);
+    for (std::size_t k = 0; k < input.stamps.size(); k += step) {
+      // Decoding stays outside the timed part (the runner's `total` excludes it too).
+      std::optional<cvo::CameraFrame> frame;
+      cv::Mat image, raw_depth;
+      if (is_pcl) {
+        frame = input.frame(k);
+      } else {
+        tum_sequence->load(k, &image, &raw_depth);
+      }
       const auto start = std::chrono::steady_clock::now();
       if (is_pcl) {
-        Cloud::Ptr cloud = toPcl(input.cloud(k, nullptr), voxel);
+        Cloud::Ptr cloud = toPcl(cvo::buildCloud(settings, *frame), voxel);
         if (previous_cloud) motion = pclMotion(method, previous_cloud, cloud, motion, resolution);
         previous_cloud = cloud;
       } else {
-        cv::Mat image, raw_depth, grey;
-        tum_sequence->load(k, &image, &raw_depth);
+        cv::Mat grey;
         cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
         cv::Mat depth = cvo::depthToMetres(raw_depth, 5000.0, 0.1, 10.0);
         if (!previous_grey.empty()) {
@@ -137,14 +157,14 @@ int main(int argc, char** argv) {
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count();
-      if (k > 0) {
+      if (k > 0) {  // the first frame only seeds the next
         pose = pose * motion;
         timer.add("frame", ms);
       }
       trajectory.append(input.stamps[k], Eigen::Isometry3d(pose));
     }
     timer.print(std::cout);
-    cvo::writeTrajectory(cli.require("out"), trajectory, input.trajectory_format);
+    cvo::writeTrajectory(cli.require("out"), trajectory, format);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "cvo_peers: " << e.what() << "\n";
