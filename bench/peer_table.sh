@@ -16,7 +16,7 @@
 # cvo_run_sequence --prior-out of the first ours run; its ms/frame is the prior's own stage,
 # without the front end that makes its grey and depth images), then the peers. ms/frame: median,
 # decoded images in and pose out (bench/frame_time.sh says what each tool's number covers).
-# After the table: "fastest peer: ...; ours ... = R x", ours being the first ours row.
+# After the table: "fastest peer: ...; ours ... = R x", ours being the first ours row (the preset).
 set -euo pipefail
 # shellcheck source=../scripts/env.sh
 source "$(dirname "$0")/../scripts/env.sh"
@@ -51,7 +51,8 @@ case "$kind" in
     preset="$CVO_ROOT/config/tum_rgbd.yaml"
     # Every valid pixel: the grid's step is 1 px while (min + max) / 2 exceeds a quarter of them.
     full_cloud=(--point-selector grid --min-points 200000 --max-points 400000)
-    methods=("ours colour|ours|--set use_color=true" "ours geometric|ours|--set use_color=false"
+    methods=("ours (preset: geometric CVO + photometric rotation)|ours|"
+      "ours colour|ours|--set use_color=true"
       "OpenCV RgbdOdometry|opencv_rgbd|" "OpenCV ICPOdometry|opencv_icp|"
       "OpenCV RgbdICPOdometry|opencv_rgbdicp|"
       "PCL GICP (full cloud, 1 cm voxels)|pcl_gicp|${full_cloud[*]}"
@@ -65,7 +66,7 @@ case "$kind" in
     # The estimates are stamped (TUM format): only the KITTI ground truth needs times.txt.
     eval_opts=(--drift-lengths "10,20,30,40,50" --gt-times "$data/times.txt")
     preset="$CVO_ROOT/config/kitti_stereo.yaml"
-    methods=("ours colour-intensity|ours|--set use_color=true"
+    methods=("ours (preset: colour-intensity CVO)|ours|"
       "ours geometric|ours|--set use_color=false"
       "PCL GICP (our stereo clouds)|pcl_gicp|--preset $preset"
       "PCL NDT (our stereo clouds)|pcl_ndt|--preset $preset")
