@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
           std::cerr << ", photometric skipped: " << update.photometric.skipped;
         } else if (update.photometric.applied) {
           std::cerr << ", photometric " << std::setprecision(3) << update.photometric.correction_deg
-                    << " deg";
+                    << " deg in " << update.photometric.iterations << " iterations";
         }
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         if (!result.why.empty()) std::cerr << " [" << result.why << "]";
