@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "cvo_odometry/core/backend_factory.hpp"
@@ -259,6 +261,58 @@ TEST(SemanticKernel, ThePoseImprovesAsLabelsBecomeInformative) {
   EXPECT_LT(errors.back(), 1e-2) << "hard labels pin x";
   for (std::size_t k = 1; k < errors.size(); ++k)
     EXPECT_LE(errors[k], errors[k - 1] + 1e-3) << "informativeness step " << k;
+}
+
+// A 4 m strip of ground (z = 0, 0.6 m wide, 5 cm bumps), its points ordered by x: each block of
+// 128 source points covers a short stretch of it.
+LabeledCloud groundStrip(int count, unsigned seed) {
+  LabeledCloud cloud(false, 0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<float> xs(static_cast<std::size_t>(count));
+  for (float& x : xs)
+    x = 4.0f * u(rng);
+  std::sort(xs.begin(), xs.end());
+  for (const float x : xs) {
+    const float y = 0.6f * u(rng);
+    cloud.add({x, y, 0.05f * std::sin(7.0f * x) * std::cos(9.0f * y)});
+  }
+  return cloud;
+}
+
+// A rotation about the strip's near end keeps the near blocks' lists valid and moves the far
+// ones past their skin (1 deg: 17 mm at 1 m, 70 mm at 4 m, against a skin of 0.35 ell = 17.5
+// mm): the sums from kept, refiltered and rebuilt blocks together are the grid's, pair for pair.
+TEST(CpuBackend, ListsKeptForSomeBlocksAndRebuiltForOthersGiveTheGridsSums) {
+  CvoParams params = syntheticParams(false);
+  const LabeledCloud target = groundStrip(3000, 1);
+  const LabeledCloud source = groundStrip(3000, 2);
+  const double ell = params.ell_min;
+  const Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d turned = pose(0.0, 0.0, 1.0 * kDeg, 0.002, 0.0, 0.0);
+  cvo::CpuBackend listed(1), fresh(1);
+  listed.setProblem(target, source, params);
+  listed.moments(start, ell);  // lists at the start pose
+  fresh.setProblem(target, source, params);
+  const cvo::kernels::MomentSums mixed = listed.oneOffMoments(turned, ell);
+  const cvo::kernels::MomentSums grid = fresh.oneOffMoments(turned, ell);
+  ASSERT_GT(grid.pairs, 10000u);
+  EXPECT_EQ(mixed.pairs, grid.pairs);
+  EXPECT_NEAR(mixed.weight, grid.weight, 1e-5 * grid.weight);
+  // Bringing the lists to the turned pose (far blocks rebuilt, near ones kept), then a smaller
+  // lengthscale (refiltered where the margin left allows): as from lists built there afresh.
+  for (const double at : {ell, 0.8 * ell}) {
+    const cvo::kernels::MomentSums updated = listed.moments(turned, at);
+    cvo::CpuBackend rebuilt(1);
+    rebuilt.setProblem(target, source, params);
+    const cvo::kernels::MomentSums reference = rebuilt.moments(turned, at);
+    EXPECT_EQ(updated.pairs, reference.pairs) << "ell " << at;
+    EXPECT_NEAR(updated.weight, reference.weight, 1e-5 * reference.weight) << "ell " << at;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(updated.target[k], reference.target[k], 1e-4 * reference.weight);
+      EXPECT_NEAR(updated.source[k], reference.source[k], 1e-4 * reference.weight);
+    }
+  }
 }
 
 TEST(CvoRegistration, ResultsAreIdenticalRunToRunAndAcrossThreadCounts) {
