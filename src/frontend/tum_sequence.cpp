@@ -25,7 +25,7 @@ TumSequence::TumSequence(const std::string& folder, double max_gap) : folder_(fo
     for (const auto& row : readFieldRows(associations, 4)) {
       frames_.push_back({parseFiniteNumber(row[0], associations),
                          parseFiniteNumber(row[2], associations), folder + "/" + row[1],
-                         folder + "/" + row[3]});
+                         folder + "/" + row[3], row[1]});
     }
   } else {
     std::vector<Listing> rgb, depth;
@@ -44,7 +44,8 @@ TumSequence::TumSequence(const std::string& folder, double max_gap) : folder_(fo
         }
       }
       if (best) {
-        frames_.push_back({r.stamp, best->stamp, folder + "/" + r.file, folder + "/" + best->file});
+        frames_.push_back(
+            {r.stamp, best->stamp, folder + "/" + r.file, folder + "/" + best->file, r.file});
       }
     }
   }

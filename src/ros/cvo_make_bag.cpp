@@ -115,8 +115,7 @@ int main(int argc, char** argv) {
                   imageMsg(image, sensor_msgs::image_encodings::BGR8, header));
         bag.write(ns + "/rgb/camera_info", header.stamp, cameraInfo(K, 0.0, header));
         if (!segmentation.empty()) {
-          const cv::Mat labels =
-              cvo::readSegmentation(segmentation, f.rgb_path.substr(sequence.folder().size() + 1));
+          const cv::Mat labels = cvo::readSegmentation(segmentation, f.rgb_listed);
           if (labels.channels() != 1 || (labels.depth() != CV_8U && labels.depth() != CV_16U)) {
             throw std::invalid_argument("--segmentation: " + f.rgb_path +
                                         "'s labels are not 8 or 16-bit class ids");

@@ -144,11 +144,11 @@ SequenceInput openSequence(const CommandLine& cli) {
     if (stamp != "depth" && stamp != "rgb") throw std::invalid_argument("--stamp: depth or rgb");
     for (const auto& f : sequence->frames())
       input.stamps.push_back(stamp == "depth" ? f.depth_stamp : f.rgb_stamp);
-    input.frame = [sequence, intrinsics, labelsOf, folder](std::size_t k) {
+    input.frame = [sequence, intrinsics, labelsOf](std::size_t k) {
       RgbdFrame frame;
       frame.intrinsics = intrinsics;
       sequence->load(k, &frame.image, &frame.depth);
-      frame.semantics = labelsOf(sequence->frames()[k].rgb_path.substr(folder.size() + 1));
+      frame.semantics = labelsOf(sequence->frames()[k].rgb_listed);
       return CameraFrame(frame);
     };
     return input;

@@ -16,6 +16,7 @@ struct TumFramePaths {
   double depth_stamp = 0.0;
   std::string rgb_path;
   std::string depth_path;
+  std::string rgb_listed;  // the colour file as the listing names it (below the folder)
 };
 
 class TumSequence {
