@@ -32,8 +32,7 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
     if (frame.right.empty()) {
       throw std::invalid_argument("stereo frame has neither a right image nor a disparity image");
     }
-    // The cropped top band is never selected, nor seeds the feature prior: not matched.
-    disparity = matcher_.disparity(frame.left, frame.right, options_.cloud.crop_top_rows);
+    disparity = matcher_.disparity(frame.left, frame.right);
     scale = 1.0;  // the matcher returns pixels
   }
   return disparityToMetres(disparity, frame.intrinsics.fx * frame.baseline, scale,

@@ -67,7 +67,7 @@ StereoMatcher::StereoMatcher(const StereoMatcherOptions& options) : options_(opt
       options_.speckle_window_size, options_.speckle_range, mode);
 }
 
-cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right, int first_row) const {
+cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right) const {
   if (left.empty() || right.empty()) throw std::invalid_argument("stereo image is empty");
   if (left.size() != right.size()) {
     throw std::invalid_argument("left image is " + std::to_string(left.cols) + "x" +
@@ -76,16 +76,13 @@ cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right, int 
   }
   // Before OpenCV, which would not refuse it (StereoMatcherOptions::minImageWidth).
   options_.checkImageSize(left.cols, left.rows);
-  first_row = std::clamp(first_row, 0, left.rows - 1);
-  const int matched_from = std::max(0, first_row - kContextRows);
-  cv::Mat fixed_point;  // CV_16S, disparity * 16, rows from matched_from
-  sgbm_->compute(toGrey(left).rowRange(matched_from, left.rows),
-                 toGrey(right).rowRange(matched_from, right.rows), fixed_point);
+  cv::Mat fixed_point;  // CV_16S, disparity * 16
+  sgbm_->compute(toGrey(left), toGrey(right), fixed_point);
+  cv::Mat pixels(fixed_point.size(), CV_32FC1);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  cv::Mat pixels(left.size(), CV_32FC1, cv::Scalar(nan));
   const int invalid_below = options_.min_disparity * 16;  // SGBM marks failures with min - 1
-  for (int v = first_row; v < left.rows; ++v) {
-    const auto* in = fixed_point.ptr<std::int16_t>(v - matched_from);
+  for (int v = 0; v < fixed_point.rows; ++v) {
+    const auto* in = fixed_point.ptr<std::int16_t>(v);
     auto* out = pixels.ptr<float>(v);
     for (int u = 0; u < fixed_point.cols; ++u)
       out[u] = in[u] < invalid_below ? nan : in[u] / 16.0f;

@@ -45,11 +45,8 @@ class StereoMatcher {
   explicit StereoMatcher(const StereoMatcherOptions& options);
 
   // 8-bit grey or BGR rectified images of one size; returns CV_32FC1 disparity in pixels of the
-  // left image, NaN where matching failed. Rows above `first_row` are not wanted (a cropped
-  // band): they are NaN, and only kContextRows of them are matched, as context for the
-  // top-down cost paths.
-  cv::Mat disparity(const cv::Mat& left, const cv::Mat& right, int first_row = 0) const;
-  static constexpr int kContextRows = 16;
+  // left image, NaN where matching failed.
+  cv::Mat disparity(const cv::Mat& left, const cv::Mat& right) const;
 
  private:
   StereoMatcherOptions options_;
