@@ -191,6 +191,7 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
   pool_.run(blocks_.size(), [&](std::size_t b) {
     if (updates[b] == Update::kKeep) return;
     Block& block = blocks_[b];
+    block.listed = false;  // until the list is whole again (an allocation may throw)
     if (updates[b] == Update::kRefilter) {
       refilterBlock(b, pose, ell, margins[b]);
     } else {
