@@ -26,7 +26,8 @@ trap 'rm -rf "$work"' EXIT
 
 # "label|median|p95" per method, from each tool's timing block (median and p95 columns).
 rows=()
-"$runner" --tum "$data" --preset "$CVO_ROOT/config/tum_rgbd.yaml" --quiet --out "$work/ours.txt" \
+"$runner" --tum "$data" --preset "$CVO_ROOT/config/tum_rgbd.yaml" --set backend=cpu --quiet \
+  --out "$work/ours.txt" \
   >"$work/ours.out" 2>"$work/ours.log" || { cat "$work/ours.log" >&2; exit 1; }
 rows+=("ours (TUM preset, total)|$(awk '/^  total/ {print $2 "|" $3}' "$work/ours.out")")
 for entry in "OpenCV RgbdOdometry|opencv_rgbd" "OpenCV ICPOdometry|opencv_icp"; do

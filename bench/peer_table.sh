@@ -94,14 +94,16 @@ for entry in "${methods[@]}"; do
       # Only the first ours run writes the prior's trajectory (the prior ignores use_color).
       prior_opts=()
       [ -e "$work/prior.txt" ] || prior_opts=(--prior-out "$work/prior.txt")
-      "$runner" "${seq[@]}" --preset "$preset" $options --stride "$stride" --quiet \
-        --format tum --out "$est" "${prior_opts[@]}" >"$work/ours.out" 2>"$log" || rc=$?
+      # The CPU backend: a table of this machine's cores, even where a GPU is usable.
+      "$runner" "${seq[@]}" --preset "$preset" --set backend=cpu $options --stride "$stride" \
+        --quiet --format tum --out "$est" "${prior_opts[@]}" >"$work/ours.out" 2>"$log" || rc=$?
+      prior_log=$log
       timing=$(awk '/^  total/ {print $2}' "$work/ours.out")
       # The feature prior's own stage time of that run, for the prior's row.
       [ ${#prior_opts[@]} -eq 0 ] ||
         prior_ms=$(awk '/^  feature prior/ {print $3}' "$work/ours.out")
       ;;
-    prior) est="$work/prior.txt" timing=${prior_ms:-} ;;
+    prior) est="$work/prior.txt" timing=${prior_ms:-} log=${prior_log:-$log} ;;
     open3d_*)
       # One thread: Open3D's colored ICP is not repeatable on several (37.1 and 13.9 mm on two
       # runs of the same frames; 7.4 mm on one thread, every time).
@@ -116,7 +118,7 @@ for entry in "${methods[@]}"; do
       ;;
   esac
   if [ "$rc" -ne 0 ] || [ ! -s "$est" ]; then
-    printf '| %-36s | %s |\n' "$label" "failed (exit $rc): $(tail -1 "$log")"
+    printf '| %-36s | %s |\n' "$label" "failed (exit $rc): $(tail -1 "$log" 2>/dev/null)"
     continue
   fi
   # Frames where a peer kept its guess: a failure the table's numbers would hide.
@@ -124,9 +126,13 @@ for entry in "${methods[@]}"; do
   [ ! -e "$log" ] || kept=$(grep -c 'keeping the guess' "$log" || true)
   [ "$kept" -eq 0 ] ||
     notes+=("$label: failed on $kept frames and kept the previous motion (its own report)")
-  "$evaluate" --gt "$gt" --est "$est" "${eval_opts[@]}" >"$work/report.txt"
+  if ! "$evaluate" --gt "$gt" --est "$est" "${eval_opts[@]}" >"$work/report.txt" \
+      2>"$work/evaluate.log"; then
+    printf '| %-36s | %s |\n' "$label" "not evaluated: $(tail -1 "$work/evaluate.log")"
+    continue
+  fi
   # Every pose must meet the ground truth, else RPE's pairs would span more than one step.
-  read -r associated estimated < <(awk '/^poses:/ {print $2, $4}' "$work/report.txt")
+  read -r associated estimated < <(awk '/^poses:/ {print $2, $4}' "$work/report.txt") || true
   [ "$associated" = "$estimated" ] ||
     notes+=("$label: only $associated of $estimated poses associated with ground truth")
   awk -v label="$label" -v ms="${timing:-nan}" '
