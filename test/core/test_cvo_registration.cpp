@@ -275,10 +275,7 @@ LabeledCloud groundStrip(int count, unsigned seed, bool color) {
   std::sort(xs.begin(), xs.end());
   for (const float x : xs) {
     const float y = 0.6f * u(rng);
-    const Eigen::Vector3f p(x, y, 0.05f * std::sin(7.0f * x) * std::cos(9.0f * y));
-    float rgb[3];
-    cvo_test::textureAt(p, rgb);
-    cloud.add(p, color ? rgb : nullptr);
+    cvo_test::addPoint(cloud, {x, y, 0.05f * std::sin(7.0f * x) * std::cos(9.0f * y)});
   }
   return cloud;
 }
