@@ -78,6 +78,8 @@ void CvoParams::validate() const {
   requirePositive(max_linear_speed, "max_linear_speed");
   requirePositive(max_angular_speed, "max_angular_speed");
   require(max_lost_frames >= 0, "max_lost_frames must be >= 0");
+  require(max_source_points == 0 || max_source_points >= kMinSubsampledPoints,
+          "max_source_points must be 0 (all) or at least " + std::to_string(kMinSubsampledPoints));
   require(photometric_iterations >= 1, "photometric_iterations must be >= 1");
   require(keyframe_cosine_ratio >= 0.0 && keyframe_cosine_ratio < 1.0,
           "keyframe_cosine_ratio must be in [0, 1)");

@@ -65,7 +65,7 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   }
   target_ = &target;
   source_ = &source;
-  stride_ = 0;
+  target_stride_ = source_count_ = 0;
   auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
   if (failover) failover->restore();  // each registration tries the GPU again
   RegistrationResult result;
@@ -81,11 +81,14 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   } else {
     runReference(guess, ell, first_frame, result.transform, report);
   }
-  useFullClouds();  // the indicators are over every point
+  // The indicators over the finest level's clouds (the source's budget of points), scaled to
+  // every source point: F sums over source points, so the subsample estimates F / k.
+  const double scale = useFinestClouds();
   const double norm = std::sqrt(static_cast<double>(target.size()) * source.size());
   report.indicator_after =
-      backend_->moments(result.transform, report.final_lengthscale).weight / norm;
-  report.indicator_before = backend_->oneOffMoments(guess, report.final_lengthscale).weight / norm;
+      scale * backend_->moments(result.transform, report.final_lengthscale).weight / norm;
+  report.indicator_before =
+      scale * backend_->oneOffMoments(guess, report.final_lengthscale).weight / norm;
   if (failover && failover->failedOver()) {
     report.backend = failover->name();
     report.warning = "GPU failed, this registration ran on the CPU: " + failover->lastError();
@@ -186,7 +189,7 @@ void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, b
   std::deque<double> ratios;
   double pair_total = 0.0;
   report.message = "iteration limit reached";
-  useFullClouds();  // the reference sums over every point
+  useFinestClouds();
   for (int it = 0; it < params_.max_iterations; ++it) {
     const kernels::MomentSums m = backend_->moments(T, ell);
     report.iterations = it + 1;
@@ -229,28 +232,40 @@ void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, b
   report.mean_pairs = report.iterations ? pair_total / report.iterations : 0.0;
 }
 
-int CvoRegistration::useCloudsForLengthscale(double ell) {
-  int stride = 1;
-  if (params_.subsample_coarse_levels && ell > params_.ell_min) {
-    // Never below ~500 points a cloud: sparser clouds give too few (colour) pairs to steer by.
-    const std::size_t smaller = std::min(target_->size(), source_->size());
-    const int most = std::max(1, static_cast<int>(smaller / 500));
-    stride = std::clamp(static_cast<int>(std::ceil(ell / params_.ell_min)), 1, most);
+std::size_t CvoRegistration::sourceBudget(const LabeledCloud& source) const {
+  if (params_.step_method != StepMethod::kProcrustes || params_.max_source_points <= 0) {
+    return source.size();
   }
-  if (stride != stride_) {
-    stride_ = stride;
-    if (stride > 1) {
-      strided_target_ = target_->strided(static_cast<std::size_t>(stride));
-      strided_source_ = source_->strided(static_cast<std::size_t>(stride));
-    }
-    backend_->setProblem(stride > 1 ? strided_target_ : *target_,
-                         stride > 1 ? strided_source_ : *source_, params_);
-  }
-  return stride;
+  return std::min(source.size(), static_cast<std::size_t>(params_.max_source_points));
 }
 
-void CvoRegistration::useFullClouds() {
-  useCloudsForLengthscale(params_.ell_min);
+double CvoRegistration::useCloudsForLengthscale(double ell) {
+  std::size_t stride = 1;
+  if (params_.subsample_coarse_levels && ell > params_.ell_min) {
+    const std::size_t smaller = std::min(target_->size(), source_->size());
+    const auto most = std::max<std::size_t>(1, smaller / kMinSubsampledPoints);
+    stride = std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(ell / params_.ell_min)), 1,
+                                     most);
+  }
+  // The source: every stride-th point, or fewer when the budget asks for it.
+  const std::size_t strided_count = (source_->size() + stride - 1) / stride;
+  const std::size_t source_count = std::min(strided_count, sourceBudget(*source_));
+  if (stride != target_stride_ || source_count != source_count_) {
+    if (stride != target_stride_ && stride > 1) strided_target_ = target_->strided(stride);
+    if (source_count != source_count_ && source_count < source_->size()) {
+      subsampled_source_ =
+          source_count == strided_count ? source_->strided(stride) : source_->thinned(source_count);
+    }
+    target_stride_ = stride;
+    source_count_ = source_count;
+    backend_->setProblem(stride > 1 ? strided_target_ : *target_,
+                         source_count < source_->size() ? subsampled_source_ : *source_, params_);
+  }
+  return static_cast<double>(source_->size()) / static_cast<double>(source_count);
+}
+
+double CvoRegistration::useFinestClouds() {
+  return useCloudsForLengthscale(params_.ell_min);
 }
 
 double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCloud& source,
@@ -273,7 +288,12 @@ double CvoRegistration::cosine(const LabeledCloud& target, const LabeledCloud& s
 }
 
 double CvoRegistration::selfProduct(const LabeledCloud& cloud, double ell) {
-  return innerProduct(cloud, cloud, Eigen::Isometry3d::Identity(), ell);
+  // Over the source's budget of points, as the registration's own sums (F(X, X) / k).
+  const std::size_t count = sourceBudget(cloud);
+  if (count >= cloud.size()) return innerProduct(cloud, cloud, Eigen::Isometry3d::Identity(), ell);
+  const LabeledCloud sample = cloud.thinned(count);
+  return static_cast<double>(cloud.size()) / static_cast<double>(count) *
+         innerProduct(cloud, sample, Eigen::Isometry3d::Identity(), ell);
 }
 
 }  // namespace cvo

@@ -51,6 +51,18 @@ LabeledCloud LabeledCloud::strided(std::size_t stride) const {
   return out;
 }
 
+LabeledCloud LabeledCloud::thinned(std::size_t count) const {
+  if (count >= size()) return *this;
+  LabeledCloud out(has_color_, semantic_classes_);
+  out.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = k * size() / count;
+    out.add(position(i), has_color_ ? color(i) : nullptr,
+            semantic_classes_ ? semantics(i) : nullptr);
+  }
+  return out;
+}
+
 long LabeledCloud::firstNonFinite() const {
   const std::size_t sem = static_cast<std::size_t>(semantic_classes_);
   for (std::size_t i = 0; i < size(); ++i) {

@@ -109,3 +109,44 @@ TEST(RealTum, RegistrationLandsWithinACentimetreAndHalfADegree) {
     }
   }
 }
+
+TEST(RealTum, SourceBudgetKeepsThePoseAndScalesTheSums) {
+  // 8000 points a frame; the registration sums over 2000 of the source's against all 8000 of the
+  // target's. The pose stays (the target's function is as dense as before) and the indicators
+  // and self products, scaled to the whole source, estimate the full sums.
+  const auto target = cvo::readCloud(kData + "/tum_clouds/frame10_8000.cloud");
+  const auto source = cvo::readCloud(kData + "/tum_clouds/frame11_8000.cloud");
+  const Eigen::Isometry3d truth = groundTruthMotion();
+  cvo::CvoParams all = tumParams(false);
+  all.max_source_points = 0;
+  cvo::CvoParams budget = all;
+  budget.max_source_points = 2000;
+  ASSERT_GT(source.size(), 3u * 2000u);
+  cvo::CvoRegistration full(all), sampled(budget);
+  // From a guess 1 cm and 1 deg off, at ell_min throughout (as from a confident feature prior).
+  const Eigen::Isometry3d guess = perturbed(truth, {0.01, 0.0, 0.0}, 1.0);
+  const auto a = full.align(target, source, guess, false, all.ell_min);
+  const auto b = sampled.align(target, source, guess, false, all.ell_min);
+  ASSERT_TRUE(a.report.converged && b.report.converged);
+  const Eigen::Isometry3d apart = a.transform.inverse() * b.transform;
+  EXPECT_LT(apart.translation().norm(), 0.002);
+  EXPECT_LT(cvo::lie::rotationAngle(apart.linear()) * 180.0 / M_PI, 0.1);
+  const Eigen::Isometry3d error = truth.inverse() * b.transform;
+  EXPECT_LT(error.translation().norm(), 0.01);
+  EXPECT_NEAR(b.report.indicator_after / a.report.indicator_after, 1.0, 0.05);
+  EXPECT_NEAR(b.report.indicator_before / a.report.indicator_before, 1.0, 0.05);
+  const double ell = all.ell_min;
+  EXPECT_NEAR(sampled.selfProduct(source, ell) / full.selfProduct(source, ell), 1.0, 0.05);
+  // A quarter of the source: about a quarter of the pairs an iteration.
+  EXPECT_NEAR(b.report.mean_pairs / a.report.mean_pairs, 0.25, 0.05);
+}
+
+TEST(RealTum, ThinnedCloudSpreadsItsPointsEvenly) {
+  const auto cloud = cvo::readCloud(kData + "/tum_clouds/frame10_3000.cloud");
+  const auto thinned = cloud.thinned(1000);
+  ASSERT_EQ(thinned.size(), 1000u);
+  for (std::size_t k = 0; k < thinned.size(); ++k) {
+    ASSERT_EQ(thinned.position(k), cloud.position(k * cloud.size() / 1000)) << k;
+  }
+  EXPECT_EQ(cloud.thinned(cloud.size() + 5).size(), cloud.size());
+}

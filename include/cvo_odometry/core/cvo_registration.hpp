@@ -41,7 +41,8 @@ class CvoRegistration {
   // The paper's alignment indicator F / sqrt(|X||Z|).
   double indicator(const LabeledCloud& target, const LabeledCloud& source,
                    const Eigen::Isometry3d& T, double ell);
-  // F(X, X) at `ell`: the squared norm of a cloud's function.
+  // F(X, X) at `ell`: the squared norm of a cloud's function (as the registration sums: over
+  // the max_source_points budget of its points against all of them, scaled).
   double selfProduct(const LabeledCloud& cloud, double ell);
   // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1].
   double cosine(const LabeledCloud& target, const LabeledCloud& source, const Eigen::Isometry3d& T,
@@ -60,11 +61,15 @@ class CvoRegistration {
   void runReference(const Eigen::Isometry3d& guess, double ell, bool first_frame,
                     Eigen::Isometry3d& T, RegistrationReport& report);
 
-  // Sets the backend's problem for lengthscale `ell`: the full clouds at ell_min; above it, when
-  // subsampling is on, every k-th point of each, k ~ ell / ell_min, so that pairs per
-  // iteration stay near the finest level's. Returns k.
-  int useCloudsForLengthscale(double ell);
-  void useFullClouds();
+  // How many of the source's points the finest level sums over (max_source_points, procrustes).
+  std::size_t sourceBudget(const LabeledCloud& source) const;
+  // Sets the backend's problem for lengthscale `ell`: at ell_min the target's points and the
+  // source's budget (max_source_points); above it, when subsampling is on, every k-th point of
+  // each, k ~ ell / ell_min (the source: no more than its budget), so that pairs per
+  // iteration stay near the finest level's. Returns the source's points over those used: the
+  // factor that scales the sums to the whole source.
+  double useCloudsForLengthscale(double ell);
+  double useFinestClouds();
 
   CvoParams params_;
   std::unique_ptr<RegistrationBackend> backend_;
@@ -72,8 +77,8 @@ class CvoRegistration {
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   LabeledCloud strided_target_;
-  LabeledCloud strided_source_;
-  int stride_ = 0;
+  LabeledCloud subsampled_source_;
+  std::size_t target_stride_ = 0, source_count_ = 0;  // 0: no problem set
 };
 
 }  // namespace cvo

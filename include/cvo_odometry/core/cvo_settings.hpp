@@ -71,6 +71,11 @@ void visitSettings(CvoParams& p, V&& v) {
   v(SettingInfo{"max_level_iterations", "solver",
                 "procrustes: iterations after which a coarse level ends", 1, 10000},
     p.max_level_iterations);
+  v(SettingInfo{"max_source_points", "solver",
+                "procrustes: most points of the current cloud a registration sums over (every "
+                "k-th; the reference keeps all its points); 0: all",
+                0, 1000000},
+    p.max_source_points);
   v(SettingInfo{"newton_at_ell_min", "solver",
                 "procrustes: Newton steps at ell_min where the curvature allows"},
     p.newton_at_ell_min);

@@ -58,6 +58,9 @@ class LabeledCloud {
   LabeledCloud transformed(const Eigen::Isometry3f& T) const;
   // Every `stride`-th point, starting with the first.
   LabeledCloud strided(std::size_t stride) const;
+  // `count` points spread evenly over the cloud's order (point floor(k size / count), the first
+  // among them); the whole cloud when it has no more.
+  LabeledCloud thinned(std::size_t count) const;
   // Index of the first point with a non-finite position or feature, or -1.
   long firstNonFinite() const;
 
