@@ -1,5 +1,7 @@
 #include "cvo_odometry/frontend/color_features.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -18,29 +20,32 @@ cv::Mat toGrey(const cv::Mat& image) {
   return grey;
 }
 
+void colorFeaturesAt(const cv::Mat& image, const cv::Mat& grey, int u, int v, float* out) {
+  const int rows = image.rows, cols = image.cols;
+  const std::uint8_t* g = grey.ptr<std::uint8_t>(v);
+  const std::uint8_t* px = image.ptr<std::uint8_t>(v);
+  if (image.channels() == 3) {
+    for (int k = 0; k < 3; ++k)
+      out[k] = px[3 * u + k] / 255.0f;
+  } else {
+    out[0] = out[1] = out[2] = px[u] / 255.0f;
+  }
+  const int left = std::max(u - 1, 0), right = std::min(u + 1, cols - 1);
+  const float gx = 0.5f * (static_cast<float>(g[right]) - g[left]);
+  const float gy =
+      0.5f * (static_cast<float>(grey.ptr<std::uint8_t>(std::min(v + 1, rows - 1))[u]) -
+              grey.ptr<std::uint8_t>(std::max(v - 1, 0))[u]);
+  out[3] = gx / 500.0f + 0.5f;
+  out[4] = gy / 500.0f + 0.5f;
+}
+
 cv::Mat colorFeatures(const cv::Mat& image) {
   const cv::Mat grey = toGrey(image);
   cv::Mat features(image.size(), CV_32FC(5));
-  const int rows = image.rows, cols = image.cols;
-  for (int v = 0; v < rows; ++v) {
-    const std::uint8_t* g = grey.ptr<std::uint8_t>(v);
-    const std::uint8_t* g_up = grey.ptr<std::uint8_t>(std::max(v - 1, 0));
-    const std::uint8_t* g_down = grey.ptr<std::uint8_t>(std::min(v + 1, rows - 1));
-    const std::uint8_t* px = image.ptr<std::uint8_t>(v);
+  for (int v = 0; v < image.rows; ++v) {
     float* out = features.ptr<float>(v);
-    for (int u = 0; u < cols; ++u) {
-      if (image.channels() == 3) {
-        for (int k = 0; k < 3; ++k)
-          out[5 * u + k] = px[3 * u + k] / 255.0f;
-      } else {
-        out[5 * u] = out[5 * u + 1] = out[5 * u + 2] = px[u] / 255.0f;
-      }
-      const int left = std::max(u - 1, 0), right = std::min(u + 1, cols - 1);
-      const float gx = 0.5f * (static_cast<float>(g[right]) - g[left]);
-      const float gy = 0.5f * (static_cast<float>(g_down[u]) - g_up[u]);
-      out[5 * u + 3] = gx / 500.0f + 0.5f;
-      out[5 * u + 4] = gy / 500.0f + 0.5f;
-    }
+    for (int u = 0; u < image.cols; ++u)
+      colorFeaturesAt(image, grey, u, v, out + 5 * u);
   }
   return features;
 }

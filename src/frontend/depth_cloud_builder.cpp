@@ -54,7 +54,9 @@ std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
     } else {
       blurred = grey;
     }
-    level.values.assign(blurred.begin<float>(), blurred.end<float>());
+    if (!blurred.isContinuous()) blurred = blurred.clone();
+    const float* values = blurred.ptr<float>();  // a plain copy: MatIterator is per element
+    level.values.assign(values, values + blurred.total());
     out.push_back(std::move(level));
   }
   return std::make_shared<const IntensityImage>(
@@ -116,7 +118,6 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
   if (valid_count == 0) throw EmptyFrameError("no pixel has valid depth");
   const cv::Mat grey = toGrey(image);
-  const cv::Mat features = colorFeatures(image);
   FrontendStats local;
   const auto pixels = selector_.select(grey, valid, &local.selection);
 
@@ -130,8 +131,9 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     if (semantics && !semantics->probabilities(p.x, p.y, probabilities.data())) continue;
     const float z = depth.at<float>(p);
     const Eigen::Vector3f position(rays[k].x * z, rays[k].y * z, z);
-    cloud.add(position, features.ptr<float>(p.y) + 5 * p.x,
-              semantics ? probabilities.data() : nullptr);
+    float features[5];
+    colorFeaturesAt(image, grey, p.x, p.y, features);
+    cloud.add(position, features, semantics ? probabilities.data() : nullptr);
   }
   if (cloud.size() == 0) {
     throw EmptyFrameError("every selected pixel belongs to an ignored class");

@@ -9,6 +9,9 @@ namespace cvo {
 // Accepts 8-bit BGR (3 channels) or grey (1 channel: B = G = R); throws std::invalid_argument
 // for anything else.
 cv::Mat colorFeatures(const cv::Mat& image);
+// The same 5 values at pixel (u, v) alone, into `out`; `grey` is toGrey(image). Cheaper than the
+// whole image when only the selected points need them.
+void colorFeaturesAt(const cv::Mat& image, const cv::Mat& grey, int u, int v, float* out);
 
 // 8-bit grey version of an 8-bit BGR or grey image.
 cv::Mat toGrey(const cv::Mat& image);
