@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -47,10 +49,33 @@ FeatureTracker::FeatureTracker(const FeatureTrackerOptions& options) : options_(
   options_.validate();
 }
 
+FeatureTracker::~FeatureTracker() {
+  finishSeeding();
+}
+
+void FeatureTracker::finishSeeding() {
+  if (!seeding_.valid()) return;
+  try {
+    seeding_.get();
+  } catch (const std::exception& e) {
+    points_.clear();
+    pixels_.clear();
+    last_pyramid_.clear();
+    seed_problem_ = std::string("finding the previous frame's corners failed: ") + e.what();
+  }
+}
+
+bool FeatureTracker::seeded() {
+  finishSeeding();
+  return !points_.empty();
+}
+
 void FeatureTracker::reset() {
+  finishSeeding();
   points_.clear();
   pixels_.clear();
   last_pyramid_.clear();
+  seed_problem_.clear();
 }
 
 std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
@@ -82,12 +107,25 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
 
 MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
                                   const PinholeIntrinsics& K, int crop_top_rows) {
+  finishSeeding();
   const auto start = std::chrono::steady_clock::now();
   std::vector<cv::Mat> current = pyramid(grey);
   MotionPrior prior =
       points_.empty() || last_pyramid_.empty() ? MotionPrior{} : solve(current, grey.size(), K);
-  if (points_.empty()) prior.problem = "no corners of a previous frame to track";
-  seed(grey, depth, K, crop_top_rows, std::move(current));
+  if (points_.empty()) {
+    prior.problem =
+        seed_problem_.empty() ? "no corners of a previous frame to track" : seed_problem_;
+  }
+  prior.seed_ms = seed_ms_;
+  seed_problem_.clear();
+  // Copies: the caller may reuse its buffers once this returns.
+  seeding_ = std::async(std::launch::async, [this, grey = grey.clone(), depth = depth.clone(), K,
+                                             crop_top_rows, levels = std::move(current)]() mutable {
+    const auto begin = std::chrono::steady_clock::now();
+    seed(grey, depth, K, crop_top_rows, std::move(levels));
+    seed_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+  });
   prior.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return prior;

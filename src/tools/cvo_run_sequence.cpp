@@ -117,7 +117,10 @@ int main(int argc, char** argv) {
         if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
         if (update.has_pose && update.trusted()) trusted.push_back(input.stamps[k]);
         if (result.prior_pose) prior_trajectory.append(input.stamps[k], *result.prior_pose);
-        if (result.prior) timer.add("feature prior", result.prior->time_ms);
+        if (result.prior) {
+          timer.add("feature prior", result.prior->time_ms);
+          timer.add("corners (beside)", result.prior->seed_ms);
+        }
         if (result.cloud) depths.add(*result.cloud);
         timer.add("frontend", result.stats.time_ms);
         if (update.attempts > 0) {

@@ -23,7 +23,8 @@ struct MotionPrior {
   std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>> observations;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
   std::string problem;    // why no motion was solved
-  double time_ms = 0.0;
+  double time_ms = 0.0;   // tracking and solving, on the caller's thread
+  double seed_ms = 0.0;   // finding the previous frame's corners, on a thread beside its frame's
 };
 
 // How well `motion` (previous <- current) explains the prior's inlier tracks: the fraction it

@@ -6,6 +6,8 @@
 // judges CVO's result by its inlier tracks (keyframe_odometry.hpp).
 #pragma once
 
+#include <future>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -30,20 +32,29 @@ struct FeatureTrackerOptions {
 class FeatureTracker {
  public:
   explicit FeatureTracker(const FeatureTrackerOptions& options);
+  ~FeatureTracker();  // waits for corners still being found
+  FeatureTracker(const FeatureTracker&) = delete;
+  FeatureTracker& operator=(const FeatureTracker&) = delete;
 
   // The previous frame's corners tracked into `grey` (8-bit) and previous <- current solved from
-  // them (`solved` false with the reason when it cannot be); then this frame's own corners,
-  // from its metric depth (CV_32FC1, NaN invalid) below `crop_top_rows`, for the next frame.
+  // them (`solved` false with the reason when it cannot be); then this frame's own corners are
+  // found, from its metric depth (CV_32FC1, NaN invalid) below `crop_top_rows`, for the next
+  // frame: on a thread of their own, since only the next frame needs them (the caller's frame
+  // goes on meanwhile; the next call waits for them, so the result does not depend on timing).
   // The first frame after construction or reset() only seeds.
   MotionPrior track(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
                     int crop_top_rows = 0);
-  bool seeded() const { return !points_.empty(); }
+  // The last frame left corners to track (waits for them).
+  bool seeded();
   void reset();
 
  private:
   std::vector<cv::Mat> pyramid(const cv::Mat& grey) const;
+  // Finds this frame's corners (grey and depth owned by the call).
   void seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
             int crop_top_rows, std::vector<cv::Mat> pyramid);
+  // Waits for the corners being found, if any; a failure there leaves none, and says why.
+  void finishSeeding();
   MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Size& size,
                     const PinholeIntrinsics& intrinsics) const;
 
@@ -51,6 +62,9 @@ class FeatureTracker {
   std::vector<cv::Point3f> points_;    // the previous frame's camera frame
   std::vector<cv::Point2f> pixels_;    // where the previous image sees them
   std::vector<cv::Mat> last_pyramid_;  // of the previous image
+  std::future<void> seeding_;          // the previous frame's corners, being found
+  double seed_ms_ = 0.0;               // how long they took
+  std::string seed_problem_;           // why finding them failed
 };
 
 }  // namespace cvo

@@ -1,0 +1,72 @@
+// FeatureTracker on real TUM frames: the corners of each frame are found on a thread beside it,
+// and the priors do not depend on when that thread runs; a tracker reset or destroyed while it
+// runs waits for it.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/feature_tracker.hpp"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+
+namespace {
+
+const std::string kTum = std::string(CVO_TEST_DATA_DIR) + "/tum_fr1_xyz";
+
+struct GreyFrame {
+  cv::Mat grey, depth;
+};
+
+GreyFrame load(const cvo::TumSequence& sequence, std::size_t k) {
+  cv::Mat image, depth;
+  sequence.load(k, &image, &depth);
+  GreyFrame frame;
+  cv::cvtColor(image, frame.grey, cv::COLOR_BGR2GRAY);
+  frame.depth = cvo::depthToMetres(depth, 5000.0, 0.1, 10.0);
+  return frame;
+}
+
+}  // namespace
+
+TEST(FeatureTracker, PriorsDoNotDependOnWhenTheCornersAreFound) {
+  const cvo::TumSequence sequence(kTum);
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  cvo::FeatureTracker prompt({}), delayed({});
+  for (std::size_t k = 0; k < 6; ++k) {
+    const GreyFrame frame = load(sequence, k);
+    const cvo::MotionPrior a = prompt.track(frame.grey, frame.depth, K);
+    // The caller's buffers may change once track() returns: the corners' thread has its own.
+    GreyFrame reused{frame.grey.clone(), frame.depth.clone()};
+    const cvo::MotionPrior b = delayed.track(reused.grey, reused.depth, K);
+    reused.grey.setTo(0);
+    reused.depth.setTo(0);
+    EXPECT_TRUE(prompt.seeded());  // waits: the next frame has corners to track
+    if (k == 0) {
+      EXPECT_FALSE(a.solved);
+      continue;
+    }
+    ASSERT_TRUE(a.solved) << a.problem;
+    ASSERT_TRUE(b.solved) << b.problem;
+    EXPECT_GT(a.inliers, 100);
+    EXPECT_EQ(a.inliers, b.inliers);
+    EXPECT_LT((a.motion.matrix() - b.motion.matrix()).norm(), 1e-12) << "frame " << k;
+    EXPECT_GT(a.seed_ms, 0.0);  // the previous frame's corners took time, beside it
+  }
+}
+
+TEST(FeatureTracker, ResetOrDestructionWhileCornersAreFoundIsSafe) {
+  const cvo::TumSequence sequence(kTum);
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  const GreyFrame first = load(sequence, 0), second = load(sequence, 1);
+  {
+    cvo::FeatureTracker tracker({});
+    tracker.track(first.grey, first.depth, K);
+  }  // destroyed with its corners' thread running
+  cvo::FeatureTracker tracker({});
+  tracker.track(first.grey, first.depth, K);
+  tracker.reset();
+  EXPECT_FALSE(tracker.seeded());
+  const cvo::MotionPrior after_reset = tracker.track(second.grey, second.depth, K);
+  EXPECT_FALSE(after_reset.solved);
+  EXPECT_NE(after_reset.problem.find("no corners"), std::string::npos) << after_reset.problem;
+}
