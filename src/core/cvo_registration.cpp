@@ -66,6 +66,7 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   target_ = &target;
   source_ = &source;
   target_stride_ = source_count_ = 0;
+  first_weight_at_final_ = -1.0;
   auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
   if (failover) failover->restore();  // each registration tries the GPU again
   RegistrationResult result;
@@ -87,8 +88,12 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   const double norm = std::sqrt(static_cast<double>(target.size()) * source.size());
   report.indicator_after =
       scale * backend_->moments(result.transform, report.final_lengthscale).weight / norm;
-  report.indicator_before =
-      scale * backend_->oneOffMoments(guess, report.final_lengthscale).weight / norm;
+  // At the guess: the first iteration's sum when it ran on these clouds at this lengthscale (a
+  // registration from a confident prior, at ell_min throughout), else a sum of its own.
+  const double at_guess = first_weight_at_final_ >= 0.0
+                              ? first_weight_at_final_
+                              : backend_->oneOffMoments(guess, report.final_lengthscale).weight;
+  report.indicator_before = scale * at_guess / norm;
   if (failover && failover->failedOver()) {
     report.backend = failover->name();
     report.warning = "GPU failed, this registration ran on the CPU: " + failover->lastError();
@@ -108,6 +113,7 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
   double previous_weight = -1.0;
   int level_iterations = 0;
   bool newton_allowed = params_.newton_at_ell_min, last_was_newton = false;
+  double first_weight = -1.0;  // F at the guess
   report.message = "iteration limit reached";
   for (int it = 0; it < params_.max_iterations; ++it) {
     useCloudsForLengthscale(ell);
@@ -116,6 +122,7 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     kernels::CurvatureSums curvature;
     if (with_curvature) curvature = backend_->curvature(T, ell);
     const kernels::MomentSums m = with_curvature ? curvature.moments : backend_->moments(T, ell);
+    if (it == 0) first_weight = m.weight;
     report.iterations = it + 1;
     pair_total += static_cast<double>(m.pairs);
     if (m.pairs < 3) {
@@ -178,6 +185,10 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
   }
   report.final_lengthscale = ell;
   report.mean_pairs = report.iterations ? pair_total / report.iterations : 0.0;
+  // The first iteration ran on the finest clouds at the final lengthscale: its sum is F at the
+  // guess.
+  if (report.lengthscale_decays == 0 && ell <= params_.ell_min)
+    first_weight_at_final_ = first_weight;
 }
 
 void CvoRegistration::runReference(const Eigen::Isometry3d& guess, double ell, bool first_frame,

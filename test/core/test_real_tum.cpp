@@ -150,3 +150,22 @@ TEST(RealTum, ThinnedCloudSpreadsItsPointsEvenly) {
   }
   EXPECT_EQ(cloud.thinned(cloud.size() + 5).size(), cloud.size());
 }
+
+TEST(RealTum, IndicatorAtTheGuessIsTheSameWhereverItComesFrom) {
+  // From ell_min (a confident prior) the first iteration's sum is the indicator at the guess;
+  // from ell_init it is a sum of its own at the final lengthscale. Both equal the indicator
+  // computed on its own.
+  const auto target = cvo::readCloud(kData + "/tum_clouds/frame10_3000.cloud");
+  const auto source = cvo::readCloud(kData + "/tum_clouds/frame11_3000.cloud");
+  const Eigen::Isometry3d guess = perturbed(groundTruthMotion(), {0.005, 0.0, 0.0}, 0.5);
+  cvo::CvoParams params = tumParams(false);
+  params.max_source_points = 0;
+  cvo::CvoRegistration registration(params);
+  for (double start : {params.ell_min, params.ell_init}) {
+    const auto result = registration.align(target, source, guess, false, start);
+    const double ell = result.report.final_lengthscale;
+    EXPECT_EQ(ell, params.ell_min);
+    const double alone = registration.indicator(target, source, guess, ell);
+    EXPECT_NEAR(result.report.indicator_before / alone, 1.0, 1e-5) << "from " << start;
+  }
+}

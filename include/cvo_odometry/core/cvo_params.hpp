@@ -51,8 +51,9 @@ struct CvoParams {
   double ell_min = 0.02;
   double ell_first_frame = 0.15;
   // From a confident feature prior: TUM fr1_xyz at strides 1 to 12 gives the same errors from
-  // 0.15 down to ell_min; 0.025 is one subsampled level above it (README "Motion prior").
-  double ell_prior = 0.025;
+  // 0.15 down to ell_min; at ell_min itself (no annealing) the registration never changes its
+  // clouds, and the indicator at the guess is its first sum (README "Motion prior").
+  double ell_prior = 0.02;
   double sigma = 0.1;
   // A pair counts when its kernel product a_ij exceeds the retain threshold: with sp_ratio > 0,
   // sp_ratio times the largest product the enabled kernels can give (sigma^2 color_sigma^2

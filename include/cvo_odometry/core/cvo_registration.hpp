@@ -79,6 +79,8 @@ class CvoRegistration {
   LabeledCloud strided_target_;
   LabeledCloud subsampled_source_;
   std::size_t target_stride_ = 0, source_count_ = 0;  // 0: no problem set
+  // F at the guess from a procrustes run that never left its first lengthscale, else -1.
+  double first_weight_at_final_ = -1.0;
 };
 
 }  // namespace cvo
