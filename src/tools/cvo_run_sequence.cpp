@@ -123,6 +123,9 @@ int main(int argc, char** argv) {
         }
         if (result.cloud) depths.add(*result.cloud);
         timer.add("frontend", result.stats.time_ms);
+        if (result.stats.matching_ms > 0.0) {
+          timer.add("frontend: matching", result.stats.matching_ms);
+        }
         if (update.attempts > 0) {
           timer.add("registration", update.report.time_ms);
           if (update.photometric.applied) timer.add("photometric", update.photometric.time_ms);
