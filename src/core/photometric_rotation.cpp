@@ -67,8 +67,14 @@ PhotometricRotationResult refineRotationPhotometrically(
   jacobians.reserve(n);
   for (int level = 0; level < reference.levelCount(); ++level) {
     // Each point's intensity in its own image (where it was selected), at this blur.
+    // A level blurred by sigma holds about one independent sample per 2 sigma pixels: every
+    // (2 sigma)-th point there (TUM fr1_xyz: the same rotation at strides 1, 3 and 5, the stage
+    // 5.0 -> 3.4 ms).
+    const auto stride =
+        static_cast<std::size_t>(std::max(1.0, std::floor(2.0 * reference.blurSigma(level))));
     forEachInBlocks(pool, n, kPointsPerBlock, [&](std::size_t j) {
       own[j] = NAN;
+      if (j % stride != 0) return;
       if (!(points[j].z() > 0.0)) return;
       const Eigen::Vector2d p = current.camera().project(points[j]);
       if (current.inside(p.x(), p.y())) own[j] = current.sample(level, p.x(), p.y()).intensity;
