@@ -294,8 +294,12 @@ double CvoRegistration::indicator(const LabeledCloud& target, const LabeledCloud
 
 double CvoRegistration::cosine(const LabeledCloud& target, const LabeledCloud& source,
                                const Eigen::Isometry3d& T, double ell) {
+  // Every sum over every point (selfProduct() estimates from the source budget, as the
+  // odometry's cosine does with its cross term from the registration).
   const double cross = innerProduct(target, source, T, ell);
-  return cross / std::sqrt(selfProduct(target, ell) * selfProduct(source, ell));
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  return cross /
+         std::sqrt(innerProduct(target, target, I, ell) * innerProduct(source, source, I, ell));
 }
 
 double CvoRegistration::selfProduct(const LabeledCloud& cloud, double ell) {

@@ -55,13 +55,19 @@ FeatureTracker::~FeatureTracker() {
 
 void FeatureTracker::finishSeeding() {
   if (!seeding_.valid()) return;
+  std::string failure;
   try {
     seeding_.get();
   } catch (const std::exception& e) {
+    failure = e.what();
+  } catch (...) {
+    failure = "an unknown error";
+  }
+  if (!failure.empty()) {
     points_.clear();
     pixels_.clear();
     last_pyramid_.clear();
-    seed_problem_ = std::string("finding the previous frame's corners failed: ") + e.what();
+    seed_problem_ = "finding the previous frame's corners failed: " + failure;
   }
 }
 
@@ -76,6 +82,8 @@ void FeatureTracker::reset() {
   pixels_.clear();
   last_pyramid_.clear();
   seed_problem_.clear();
+  seed_ms_ = 0.0;
+  has_previous_ = false;
 }
 
 std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
@@ -108,6 +116,17 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
 MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
                                   const PinholeIntrinsics& K, int crop_top_rows) {
   finishSeeding();
+  try {
+    return trackAndSeed(grey, depth, K, crop_top_rows);
+  } catch (...) {
+    // The next frame must not be tracked from an older one: start over from it.
+    reset();
+    throw;
+  }
+}
+
+MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
+                                         const PinholeIntrinsics& K, int crop_top_rows) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<cv::Mat> current = pyramid(grey);
   MotionPrior prior =
@@ -118,6 +137,12 @@ MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
   }
   prior.seed_ms = seed_ms_;
   seed_problem_.clear();
+  seed_ms_ = 0.0;
+  // This frame's corners replace the previous frame's; none if the search cannot even start.
+  points_.clear();
+  pixels_.clear();
+  last_pyramid_.clear();
+  has_previous_ = true;
   // Copies: the caller may reuse its buffers once this returns.
   seeding_ = std::async(std::launch::async, [this, grey = grey.clone(), depth = depth.clone(), K,
                                              crop_top_rows, levels = std::move(current)]() mutable {

@@ -148,7 +148,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   if (!settings_.features.enabled || images.grey.empty()) {
     tracker_->reset();  // the prior relates this frame and the next only: none without images
   } else {
-    const bool tracked = tracker_->seeded();
+    // From the second frame on, the prior (solved, or why not) relates this frame to the last.
+    const bool tracked = tracker_->hasPreviousFrame();
     MotionPrior prior =
         tracker_->track(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
     if (tracked) input.prior = result.prior = std::move(prior);

@@ -169,3 +169,16 @@ TEST(RealTum, IndicatorAtTheGuessIsTheSameWhereverItComesFrom) {
     EXPECT_NEAR(result.report.indicator_before / alone, 1.0, 1e-5) << "from " << start;
   }
 }
+
+TEST(RealTum, CosineOfACloudWithItselfIsOneAboveTheSourceBudget) {
+  // 8000 points, twice the default budget: cosine() sums over every point, so the cloud's
+  // function with itself gives exactly 1, and the estimate the odometry uses is close to it.
+  const auto cloud = cvo::readCloud(kData + "/tum_clouds/frame10_8000.cloud");
+  cvo::CvoParams params = tumParams(false);
+  ASSERT_GT(cloud.size(), static_cast<std::size_t>(params.max_source_points));
+  cvo::CvoRegistration registration(params);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  EXPECT_NEAR(registration.cosine(cloud, cloud, I, params.ell_min), 1.0, 1e-9);
+  const double exact = registration.innerProduct(cloud, cloud, I, params.ell_min);
+  EXPECT_NEAR(registration.selfProduct(cloud, params.ell_min) / exact, 1.0, 0.05);
+}

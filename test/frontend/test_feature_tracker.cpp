@@ -1,6 +1,6 @@
 // FeatureTracker on real TUM frames: the corners of each frame are found on a thread beside it,
-// and the priors do not depend on when that thread runs; a tracker reset or destroyed while it
-// runs waits for it.
+// from copies of the caller's images (which the caller may reuse at once); a tracker reset or
+// destroyed while that thread runs waits for it.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -28,7 +28,7 @@ GreyFrame load(const cvo::TumSequence& sequence, std::size_t k) {
 
 }  // namespace
 
-TEST(FeatureTracker, PriorsDoNotDependOnWhenTheCornersAreFound) {
+TEST(FeatureTracker, ImagesTheCallerReusesDoNotChangeThePriors) {
   const cvo::TumSequence sequence(kTum);
   const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
   cvo::FeatureTracker prompt({}), delayed({});
@@ -66,6 +66,7 @@ TEST(FeatureTracker, ResetOrDestructionWhileCornersAreFoundIsSafe) {
   tracker.track(first.grey, first.depth, K);
   tracker.reset();
   EXPECT_FALSE(tracker.seeded());
+  EXPECT_FALSE(tracker.hasPreviousFrame());
   const cvo::MotionPrior after_reset = tracker.track(second.grey, second.depth, K);
   EXPECT_FALSE(after_reset.solved);
   EXPECT_NE(after_reset.problem.find("no corners"), std::string::npos) << after_reset.problem;

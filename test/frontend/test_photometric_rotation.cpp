@@ -138,6 +138,21 @@ TEST(PhotometricRotation, CorrectsAWrongRotationTowardsTheGroundTruth) {
   }
 }
 
+TEST(PhotometricRotation, ASmallCloudStillGetsItsRotation) {
+  // The blurred level uses every second point: a cloud just above min_tracking_points (300) in
+  // view must still be refined there, not refused for having half of them.
+  const TumPair pair = loadPair(17);
+  cvo::CvoParams params = presetParams();
+  params.photometric_iterations = 60;
+  const cvo::LabeledCloud small = pair.current.thinned(450);
+  const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 0.5);
+  const cvo::PhotometricRotationResult out = cvo::refineRotationPhotometrically(
+      *pair.reference.image(), *pair.current.image(), small, guess, params);
+  ASSERT_TRUE(out.report.applied) << out.report.skipped;
+  EXPECT_GE(out.report.points, 300u);
+  EXPECT_LT(angleDeg(out.transform.linear() * pair.truth.linear().transpose()), 0.5);
+}
+
 TEST(PhotometricRotation, GivesTheSameRotationOnAnyThreadCount) {
   // Points are handled in parallel but gathered in point order: bit-identical results.
   const TumPair pair = loadPair(17);

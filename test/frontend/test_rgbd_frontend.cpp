@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
@@ -217,3 +218,23 @@ TEST(RgbdFrontend, BadInputGetsAClearError) {
 }
 
 }  // namespace
+
+TEST(RgbdFrontend, ColourFeaturesOfOnePixelAreThoseOfTheWholeImage) {
+  // The cloud builder computes the five values only at the selected pixels: they must be the
+  // feature image's, borders included, for colour and grey images alike.
+  const TumFrame f = loadFrame(3);
+  cv::Mat grey_image;
+  cv::cvtColor(f.image, grey_image, cv::COLOR_BGR2GRAY);
+  for (const cv::Mat& image : {f.image, grey_image}) {
+    const cv::Mat all = cvo::colorFeatures(image);
+    const cv::Mat grey = cvo::toGrey(image);
+    for (const cv::Point p : {cv::Point(0, 0), cv::Point(639, 479), cv::Point(0, 200),
+                              cv::Point(320, 0), cv::Point(123, 456), cv::Point(517, 31)}) {
+      float one[5];
+      cvo::colorFeaturesAt(image, grey, p.x, p.y, one);
+      for (int k = 0; k < 5; ++k) {
+        EXPECT_EQ(one[k], all.ptr<float>(p.y)[5 * p.x + k]) << p << " channel " << k;
+      }
+    }
+  }
+}

@@ -37,14 +37,14 @@ enum class LostFramePolicy {
   kReset            // restart tracking from the frame, holding the last pose
 };
 
-// Every parameter of the core. Names, ranges and meanings: the settings table
-// (cvo_settings.hpp, README "Parameters"). Defaults: the RGB-D preset (a Kinect-class camera at
-// 30 Hz): the paper's TUM kernels with ell_min 0.02, geometry only, then the photometric stage;
-// config/*.yaml state only what they change.
 // Fewest points a subsampled cloud keeps (coarse levels, the source budget): sparser clouds give
 // too few (colour) pairs to steer by.
 inline constexpr int kMinSubsampledPoints = 500;
 
+// Every parameter of the core. Names, ranges and meanings: the settings table
+// (cvo_settings.hpp, README "Parameters"). Defaults: the RGB-D preset (a Kinect-class camera at
+// 30 Hz): the paper's TUM kernels with ell_min 0.02, geometry only, then the photometric stage;
+// config/*.yaml state only what they change.
 struct CvoParams {
   // Geometric kernel k(x, z) = sigma^2 exp(-|x - z|^2 / (2 ell^2)).
   double ell_init = 0.15;
@@ -97,10 +97,10 @@ struct CvoParams {
   bool subsample_coarse_levels = true;
   double max_overrelaxation = 2.0;
   int max_level_iterations = 30;
-  // Procrustes: the registration sums over at most this many points of the source (every k-th,
-  // evenly), the target keeping all of its points: the target's function stays as smooth as
-  // its density makes it while the cost, linear in the source's points, is capped. 0: all.
-  // Measured in README "Source point budget".
+  // Procrustes: the registration sums over at most this many points of the source (spread
+  // evenly over its order), the target keeping all of its points: the target's function stays as
+  // smooth as its density makes it while the cost, linear in the source's points, is capped. 0:
+  // all. Measured in README "Source point budget".
   int max_source_points = 4000;
   // Newton steps (analytic gradient and Hessian of sum (a - sp_thres)_+) where the Hessian is
   // negative definite and the step stays within 10x the MM step; after the first Newton step

@@ -44,7 +44,8 @@ class CvoRegistration {
   // F(X, X) at `ell`: the squared norm of a cloud's function (as the registration sums: over
   // the max_source_points budget of its points against all of them, scaled).
   double selfProduct(const LabeledCloud& cloud, double ell);
-  // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1].
+  // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1], every sum
+  // over every point.
   double cosine(const LabeledCloud& target, const LabeledCloud& source, const Eigen::Isometry3d& T,
                 double ell);
 
@@ -78,7 +79,8 @@ class CvoRegistration {
   const LabeledCloud* source_ = nullptr;
   LabeledCloud strided_target_;
   LabeledCloud subsampled_source_;
-  std::size_t target_stride_ = 0, source_count_ = 0;  // 0: no problem set
+  // The clouds align() gave the backend last; 0: none yet in this align().
+  std::size_t target_stride_ = 0, source_count_ = 0;
   // F at the guess from a procrustes run that never left its first lengthscale, else -1.
   double first_weight_at_final_ = -1.0;
 };

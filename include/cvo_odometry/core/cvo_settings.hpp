@@ -72,8 +72,8 @@ void visitSettings(CvoParams& p, V&& v) {
                 "procrustes: iterations after which a coarse level ends", 1, 10000},
     p.max_level_iterations);
   v(SettingInfo{"max_source_points", "solver",
-                "procrustes: most points of the current cloud a registration sums over (every "
-                "k-th; the reference keeps all its points); 0: all",
+                "procrustes: most points of the current cloud a registration sums over (spread "
+                "evenly; the reference cloud keeps all of its points); 0: all, else >= 500",
                 0, 1000000},
     p.max_source_points);
   v(SettingInfo{"newton_at_ell_min", "solver",

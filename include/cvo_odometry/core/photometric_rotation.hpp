@@ -38,11 +38,11 @@ struct PhotometricRotationResult {
 };
 
 // `reference_from_current`: CVO's estimate. Returns it unchanged (with `skipped` set) when the
-// images' levels differ, too few points (< params.min_tracking_points) land in the reference
-// image, the solve degenerates, the intensities correlate below 0.5 at the result (the images
-// do not show the same scene: a black frame, a covered lens), or the correction exceeds
-// params.photometric_max_correction. The points are evaluated on `pool` (null: this thread);
-// the result is the same on any thread count.
+// images' levels differ, too few points (< params.min_tracking_points, divided by the point stride
+// of a blurred level) land in the reference image, the solve degenerates, the intensities correlate
+// below 0.5 at the result (the images do not show the same scene: a black frame, a covered lens),
+// or the correction exceeds params.photometric_max_correction. The points are evaluated on `pool`
+// (null: this thread); the result is the same on any thread count.
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
     const Eigen::Isometry3d& reference_from_current, const CvoParams& params,

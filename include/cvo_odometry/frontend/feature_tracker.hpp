@@ -46,6 +46,9 @@ class FeatureTracker {
                     int crop_top_rows = 0);
   // The last frame left corners to track (waits for them).
   bool seeded();
+  // A frame was tracked since construction or reset(): the next prior relates two frames, solved
+  // or with the reason why not (no corners, a failed corner search).
+  bool hasPreviousFrame() const { return has_previous_; }
   void reset();
 
  private:
@@ -55,6 +58,9 @@ class FeatureTracker {
             int crop_top_rows, std::vector<cv::Mat> pyramid);
   // Waits for the corners being found, if any; a failure there leaves none, and says why.
   void finishSeeding();
+  // track() after the wait: the prior, then this frame's corners started on their thread.
+  MotionPrior trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
+                           const PinholeIntrinsics& intrinsics, int crop_top_rows);
   MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Size& size,
                     const PinholeIntrinsics& intrinsics) const;
 
@@ -65,6 +71,7 @@ class FeatureTracker {
   std::future<void> seeding_;          // the previous frame's corners, being found
   double seed_ms_ = 0.0;               // how long they took
   std::string seed_problem_;           // why finding them failed
+  bool has_previous_ = false;
 };
 
 }  // namespace cvo
