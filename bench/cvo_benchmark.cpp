@@ -29,6 +29,8 @@ const char* kUsage =
     "  --repeat N            registrations per configuration (7)\n"
     "  --threads N           CPU threads (0: all)\n"
     "  --preset FILE         base parameters\n"
+    "  --max-source-points N the registration's source budget (0, the default here: every point,\n"
+    "                        so that a row's size is what it sums over)\n"
     "  --reference-max-size N  skip the reference method above this size (3000)\n"
     "  --check-cuda          only say whether a CUDA device is usable (exit 0, else 3)\n";
 
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
   try {
     const cvo::CommandLine cli(argc, argv,
                                {"data", "sizes", "methods", "kernels", "backends", "repeat",
-                                "threads", "preset", "reference-max-size"},
+                                "max-source-points", "threads", "preset", "reference-max-size"},
                                {"help", "check-cuda"});
     if (cli.has("help")) {
       std::cout << kUsage;
@@ -79,6 +81,7 @@ int main(int argc, char** argv) {
     if (cli.has("preset"))
       base = cvo::loadCvoParams(cli.get("preset"), base, cvo::UnknownKeys::kIgnore);
     base.num_threads = cli.getInt("threads", 0);
+    base.max_source_points = cli.getInt("max-source-points", 0);
     std::string default_backends = "cpu";
     if (cuda) {
       default_backends += ",cuda";
