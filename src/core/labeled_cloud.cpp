@@ -41,26 +41,26 @@ LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
   return out;
 }
 
-LabeledCloud LabeledCloud::strided(std::size_t stride) const {
+LabeledCloud LabeledCloud::picked(std::size_t count,
+                                  const std::function<std::size_t(std::size_t)>& index) const {
   LabeledCloud out(has_color_, semantic_classes_);
-  out.reserve(size() / std::max<std::size_t>(stride, 1) + 1);
-  for (std::size_t i = 0; i < size(); i += std::max<std::size_t>(stride, 1)) {
+  out.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = index(k);
     out.add(position(i), has_color_ ? color(i) : nullptr,
             semantic_classes_ ? semantics(i) : nullptr);
   }
   return out;
 }
 
+LabeledCloud LabeledCloud::strided(std::size_t stride) const {
+  stride = std::max<std::size_t>(stride, 1);
+  return picked((size() + stride - 1) / stride, [&](std::size_t k) { return k * stride; });
+}
+
 LabeledCloud LabeledCloud::thinned(std::size_t count) const {
   if (count >= size()) return *this;
-  LabeledCloud out(has_color_, semantic_classes_);
-  out.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    const std::size_t i = k * size() / count;
-    out.add(position(i), has_color_ ? color(i) : nullptr,
-            semantic_classes_ ? semantics(i) : nullptr);
-  }
-  return out;
+  return picked(count, [&](std::size_t k) { return k * size() / count; });
 }
 
 long LabeledCloud::firstNonFinite() const {

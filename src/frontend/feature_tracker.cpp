@@ -64,11 +64,15 @@ void FeatureTracker::finishSeeding() {
     failure = "an unknown error";
   }
   if (!failure.empty()) {
-    points_.clear();
-    pixels_.clear();
-    last_pyramid_.clear();
+    forgetCorners();
     seed_problem_ = "finding the previous frame's corners failed: " + failure;
   }
+}
+
+void FeatureTracker::forgetCorners() {
+  points_.clear();
+  pixels_.clear();
+  last_pyramid_.clear();
 }
 
 bool FeatureTracker::seeded() {
@@ -78,9 +82,7 @@ bool FeatureTracker::seeded() {
 
 void FeatureTracker::reset() {
   finishSeeding();
-  points_.clear();
-  pixels_.clear();
-  last_pyramid_.clear();
+  forgetCorners();
   seed_problem_.clear();
   seed_ms_ = 0.0;
   has_previous_ = false;
@@ -95,8 +97,6 @@ std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
 
 void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& K,
                           int crop_top_rows, std::vector<cv::Mat> levels) {
-  points_.clear();
-  pixels_.clear();
   last_pyramid_ = std::move(levels);
   if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
   cv::Mat mask = (depth == depth);  // NaN: no depth
@@ -139,9 +139,7 @@ MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& dep
   seed_problem_.clear();
   seed_ms_ = 0.0;
   // This frame's corners replace the previous frame's; none if the search cannot even start.
-  points_.clear();
-  pixels_.clear();
-  last_pyramid_.clear();
+  forgetCorners();
   has_previous_ = true;
   // Copies: the caller may reuse its buffers once this returns.
   seeding_ = std::async(std::launch::async, [this, grey = grey.clone(), depth = depth.clone(), K,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -65,6 +66,10 @@ class LabeledCloud {
   long firstNonFinite() const;
 
  private:
+  // The `count` points index(0), index(1), ... (features too; no image).
+  LabeledCloud picked(std::size_t count,
+                      const std::function<std::size_t(std::size_t)>& index) const;
+
   bool has_color_ = false;
   int semantic_classes_ = 0;
   std::vector<float> positions_;
