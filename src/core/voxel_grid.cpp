@@ -44,13 +44,15 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
   } else {
     std::stable_sort(order_.begin(), order_.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return cell_of[a] < cell_of[b]; });
-    cells_.clear();
-    cells_.reserve(count);
+    std::size_t occupied = 0;
+    for (std::size_t k = 0; k < count; ++k)
+      occupied += k == 0 || cell_of[order_[k]] != cell_of[order_[k - 1]];
+    cells_.reset(occupied);
     for (std::uint32_t k = 0; k < count;) {
       std::uint32_t end = k + 1;
       while (end < count && cell_of[order_[end]] == cell_of[order_[k]])
         ++end;
-      cells_.emplace(cell_of[order_[k]], std::make_pair(k, end));
+      cells_.insert(cell_of[order_[k]], {k, end});
       k = end;
     }
     start_.clear();

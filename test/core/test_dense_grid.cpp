@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cvo_odometry/core/cell_hash_table.hpp"
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
@@ -64,6 +65,30 @@ TEST(DenseGrid, FindsTheNeighboursInAHashedGridToo) {
   for (const float cells_per_radius : {1.0f, 2.0f}) {
     expectExactNeighbours(positions, cloud.size() + 1, 0.05f / cells_per_radius, 0.05f);
   }
+}
+
+TEST(CellHashTable, FindsEveryInsertedKeyAndNoOther) {
+  // Keys a stride of 2^21 apart (neighbouring cells along one axis) and a dense run, with the
+  // table at its fullest (half): every probe chain must end at the right slot or an empty one.
+  cvo::CellHashTable table;
+  std::vector<std::uint64_t> keys;
+  for (std::uint64_t k = 0; k < 1000; ++k)
+    keys.push_back(k << 21);
+  for (std::uint64_t k = 0; k < 24; ++k)
+    keys.push_back((std::uint64_t{1} << 62) + k);
+  table.reset(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    table.insert(keys[i], {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i + 1)});
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const cvo::CellHashTable::Range* range = table.find(keys[i]);
+    ASSERT_NE(range, nullptr) << "key " << keys[i];
+    EXPECT_EQ(range->first, i);
+    EXPECT_EQ(range->second, i + 1);
+  }
+  for (std::uint64_t k = 0; k < 1000; ++k)
+    EXPECT_EQ(table.find((k << 21) + 1), nullptr);
+  table.clear();
+  EXPECT_EQ(table.find(keys[0]), nullptr);
 }
 
 TEST(DenseGrid, EveryPointOfTheBoxHasACell) {

@@ -2,15 +2,15 @@
 // (counting sort) and kept as separate x, y, z arrays in that order, so that the candidates of a
 // query are a few contiguous ranges a vectorised loop can read. Where the bounding box spans few
 // enough cells the grid is dense, with the z cells of one (x, y) column contiguous (one range a
-// column); over larger extents (outdoor scenes) occupied cells are found through a hash map.
+// column); over larger extents (outdoor scenes) occupied cells are found through a hash table.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
+#include "cvo_odometry/core/cell_hash_table.hpp"
 #include "cvo_odometry/core/dense_grid.hpp"
 
 namespace cvo {
@@ -41,8 +41,9 @@ class VoxelGrid {
     for (int x = first[0]; x <= last[0]; ++x) {
       for (int y = first[1]; y <= last[1]; ++y) {
         for (int z = first[2]; z <= last[2]; ++z) {
-          const auto it = cells_.find(key(x, y, z));
-          if (it != cells_.end()) visit(it->second.first, it->second.second);
+          if (const CellHashTable::Range* range = cells_.find(key(x, y, z))) {
+            visit(range->first, range->second);
+          }
         }
       }
     }
@@ -73,7 +74,7 @@ class VoxelGrid {
   kernels::DenseGridShape shape_{{0.0f, 0.0f, 0.0f}, 0.0f, {0, 0, 0}};
   bool dense_ = true;
   std::vector<std::uint32_t> start_;  // dense: first sorted point of each cell, plus the end
-  std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> cells_;  // sparse
+  CellHashTable cells_;               // sparse: occupied cells
   std::vector<std::uint32_t> order_;  // sorted slot -> point index
   std::vector<float> xs_, ys_, zs_;   // positions in sorted order
 };
