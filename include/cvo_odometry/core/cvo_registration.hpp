@@ -41,8 +41,9 @@ class CvoRegistration {
   // The paper's alignment indicator F / sqrt(|X||Z|).
   double indicator(const LabeledCloud& target, const LabeledCloud& source,
                    const Eigen::Isometry3d& T, double ell);
-  // F(X, X) at `ell`: the squared norm of a cloud's function (as the registration sums: over
-  // the max_source_points budget of its points against all of them, scaled).
+  // F(X, X) at `ell`: the squared norm of a cloud's function, estimated as the registration
+  // sums: over an even sample of its points (1000, or the max_source_points budget if smaller)
+  // against all of them, scaled.
   double selfProduct(const LabeledCloud& cloud, double ell);
   // Cosine of the angle between the two functions: F_XZ / sqrt(F_XX F_ZZ), in [0, 1], every sum
   // over every point.
