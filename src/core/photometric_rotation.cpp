@@ -18,13 +18,10 @@ constexpr double kStepTolerance = 1e-4;
 // images do not show the same scene (a covered lens, a black frame): the rotation is not taken.
 constexpr double kMinCorrelation = 0.5;
 
-// Median of |r| (partially sorts a copy).
-double medianAbsolute(const std::vector<double>& residuals) {
-  std::vector<double> a(residuals.size());
-  std::transform(residuals.begin(), residuals.end(), a.begin(),
-                 [](double r) { return std::abs(r); });
-  const auto middle = a.begin() + static_cast<std::ptrdiff_t>(a.size() / 2);
-  std::nth_element(a.begin(), middle, a.end());
+// Median of `values` (partially sorts them).
+double median(std::vector<double>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
   return *middle;
 }
 
@@ -59,12 +56,14 @@ PhotometricRotationResult refineRotationPhotometrically(
   constexpr std::size_t kPointsPerBlock = 512;
   // Per point (NaN residual: not observed), filled in parallel, then gathered in point order:
   // the same sums whatever the thread count.
-  std::vector<double> own(n), point_residual(n);
+  std::vector<double> own(n), point_residual(n, NAN);
   std::vector<Eigen::Matrix<double, 6, 1>> point_jacobian(n);
-  std::vector<double> residuals, sampled_own;
-  std::vector<Eigen::Matrix<double, 6, 1>> jacobians;
-  residuals.reserve(n);
-  jacobians.reserve(n);
+  std::vector<double> magnitudes;  // |residual| of the observed points, for the median
+  magnitudes.reserve(n);
+  const std::size_t blocks = (n + kPointsPerBlock - 1) / kPointsPerBlock;
+  // Each block's share of the normal equations, summed in block order.
+  std::vector<Eigen::Matrix<double, 6, 6>> block_H(blocks);
+  std::vector<Eigen::Matrix<double, 6, 1>> block_g(blocks);
   for (int level = 0; level < reference.levelCount(); ++level) {
     // Each point's intensity in its own image (where it was selected), at this blur. A blurred
     // level only steers the finer ones: every (2 sigma)-th point of the cloud's order serves it
@@ -95,31 +94,44 @@ PhotometricRotationResult refineRotationPhotometrically(
         point_jacobian[j] << Y.cross(dI), dI;
         point_residual[j] = s.intensity - own[j];
       });
-      residuals.clear();
-      jacobians.clear();
-      sampled_own.clear();
+      magnitudes.clear();
       for (std::size_t j = 0; j < n; ++j) {
-        if (std::isnan(point_residual[j])) continue;
-        residuals.push_back(point_residual[j]);
-        sampled_own.push_back(own[j]);
-        jacobians.push_back(point_jacobian[j]);
+        if (!std::isnan(point_residual[j])) magnitudes.push_back(std::abs(point_residual[j]));
       }
-      report.points = residuals.size();
-      if (residuals.size() < needed) {
-        return finish("only " + std::to_string(residuals.size()) + " of " +
+      report.points = magnitudes.size();
+      if (magnitudes.size() < needed) {
+        return finish("only " + std::to_string(magnitudes.size()) + " of " +
                       std::to_string((n + stride - 1) / stride) +
                       " points inside the reference image at blur level " + std::to_string(level));
       }
-      const double scale = std::max(kMadToSigma * medianAbsolute(residuals), 1e-6);
+      const double scale = std::max(kMadToSigma * median(magnitudes), 1e-6);
       const double huber = kHuberScale * scale;
+      const auto accumulate = [&](std::size_t b) {
+        Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+        Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+        const std::size_t end = std::min(n, (b + 1) * kPointsPerBlock);
+        for (std::size_t j = b * kPointsPerBlock; j < end; ++j) {
+          const double r = point_residual[j];
+          if (std::isnan(r)) continue;
+          const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+          // Fixed-size outer product: unrolled, far cheaper than a triangular rank update.
+          H.noalias() += (w * point_jacobian[j]) * point_jacobian[j].transpose();
+          g += w * r * point_jacobian[j];
+        }
+        block_H[b] = H;
+        block_g[b] = g;
+      };
+      if (pool) {
+        pool->run(blocks, accumulate);
+      } else {
+        for (std::size_t b = 0; b < blocks; ++b)
+          accumulate(b);
+      }
       Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
       Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-      for (std::size_t k = 0; k < residuals.size(); ++k) {
-        const double r = residuals[k];
-        const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
-        // Fixed-size outer product: unrolled, far cheaper than a triangular rank update.
-        H.noalias() += (w * jacobians[k]) * jacobians[k].transpose();
-        g += w * r * jacobians[k];
+      for (std::size_t b = 0; b < blocks; ++b) {
+        H += block_H[b];
+        g += block_g[b];
       }
       const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
       const Eigen::Matrix<double, 6, 1> xi = -ldlt.solve(g);
@@ -134,15 +146,19 @@ PhotometricRotationResult refineRotationPhotometrically(
   }
   // Correlation of own and reference intensities (reference = own + residual) at the last step.
   double mean_own = 0.0, mean_ref = 0.0;
-  for (std::size_t k = 0; k < residuals.size(); ++k) {
-    mean_own += sampled_own[k];
-    mean_ref += sampled_own[k] + residuals[k];
+  std::size_t observed = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (std::isnan(point_residual[j])) continue;
+    mean_own += own[j];
+    mean_ref += own[j] + point_residual[j];
+    ++observed;
   }
-  mean_own /= residuals.size();
-  mean_ref /= residuals.size();
+  mean_own /= static_cast<double>(observed);
+  mean_ref /= static_cast<double>(observed);
   double s_oo = 0.0, s_rr = 0.0, s_or = 0.0;
-  for (std::size_t k = 0; k < residuals.size(); ++k) {
-    const double o = sampled_own[k] - mean_own, r = sampled_own[k] + residuals[k] - mean_ref;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (std::isnan(point_residual[j])) continue;
+    const double o = own[j] - mean_own, r = own[j] + point_residual[j] - mean_ref;
     s_oo += o * o;
     s_rr += r * r;
     s_or += o * r;
