@@ -22,6 +22,8 @@ constexpr std::size_t kSelfProductPoints = 1000;
 // third (14.0 -> 14.6 iterations a frame, the poses within 0.01 mm), 12.0-13.2 with the first
 // step's throughout.
 constexpr int kNewtonStepsPerHessian = 3;
+// Relative fall of the smoothed F below which it counts as unchanged.
+constexpr double kFallTolerance = 1e-8;
 
 }  // namespace
 
@@ -127,7 +129,8 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
   bool newton_allowed = params_.newton_at_ell_min, last_was_newton = false;
   double first_weight = -1.0;        // F at the guess
   kernels::CurvatureSums curvature;  // the Hessian of the last curvature pass, this step's moments
-  int hessian_uses = 0;
+  int hessian_uses = 0;              // Newton iterations since that pass
+  bool last_newton_fresh = false;    // the last Newton step's Hessian was summed at its pose
   report.message = "iteration limit reached";
   for (int it = 0; it < params_.max_iterations; ++it) {
     useCloudsForLengthscale(ell);
@@ -152,9 +155,16 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     // (the retained-pair sum F jumps as pairs cross the threshold): steer by that.
     const double smooth_weight =
         m.weight - params_.retainThreshold() * static_cast<double>(m.pairs);
-    const bool fell = previous_weight >= 0.0 && smooth_weight < previous_weight;
-    // A Newton step after which F fell: its quadratic model misleads here, MM steps from now on.
-    if (fell && last_was_newton) newton_allowed = false;
+    // Fell, beyond the rounding between a curvature pass and a plain one (the same sum in
+    // another order: ~1e-9 of F).
+    const bool fell = previous_weight >= 0.0 &&
+                      smooth_weight < previous_weight - kFallTolerance * std::abs(previous_weight);
+    // A Newton step after which F fell: on a fresh Hessian its quadratic model misleads here, MM
+    // steps from now on; on a reused one, the next step sums a fresh Hessian.
+    if (fell && last_was_newton) {
+      if (last_newton_fresh) newton_allowed = false;
+      hessian_uses = 0;
+    }
     last_was_newton = false;
     if (previous_weight >= 0.0) {
       omega = smooth_weight >= previous_weight ? std::min(omega * 1.5, params_.max_overrelaxation)
@@ -164,19 +174,24 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     const Vector6d step = lie::logSE3(weightedProcrustes(m));
     Vector6d newton;
     // Near the optimum MM steps converge linearly, slowly along weakly constrained directions;
-    // Newton's converge quadratically. Taken only while F rises, where the Hessian is negative
-    // definite and the step stays within 10x the MM step (a guard against a misleading model).
+    // Newton's converge quadratically. Taken only while F rises, where the Hessian (the last
+    // one summed) is negative definite and the step stays within 10x the MM step (a guard
+    // against a misleading model).
     bool took_newton = false;
     if (with_curvature && !fell) {
       took_newton =
           newtonStep(curvature, ell, &newton) && newton.norm() < 10.0 * step.norm() + 1e-4;
-      // A model without a maximum nearby will not have one an iteration later either: stop
-      // paying for the curvature sums.
-      newton_allowed = took_newton;
+      if (!took_newton) {
+        // A fresh model without a maximum nearby will not have one an iteration later either:
+        // stop paying for the curvature sums. A reused one is summed afresh first.
+        if (fresh_hessian) newton_allowed = false;
+        hessian_uses = 0;
+      }
     }
     if (took_newton) {
       T = lie::orthonormalized(lie::expSE3(newton) * T);
       last_was_newton = true;
+      last_newton_fresh = fresh_hessian;
     } else {
       T = lie::orthonormalized(lie::expSE3(omega * step) * T);
     }
