@@ -54,8 +54,8 @@ PhotometricRotationResult refineRotationPhotometrically(
 
   Eigen::Isometry3d T = reference_from_current;
   constexpr std::size_t kPointsPerBlock = 512;
-  // Per point (NaN residual: not observed), filled in parallel, then gathered in point order:
-  // the same sums whatever the thread count.
+  // Per point (NaN residual: not observed), filled in parallel; the normal equations summed per
+  // block of points, the blocks added in order: the same sums whatever the thread count.
   std::vector<double> own(n), point_residual(n, NAN);
   std::vector<Eigen::Matrix<double, 6, 1>> point_jacobian(n);
   std::vector<double> magnitudes;  // |residual| of the observed points, for the median

@@ -68,12 +68,15 @@ TEST(DenseGrid, FindsTheNeighboursInAHashedGridToo) {
 }
 
 TEST(CellHashTable, FindsEveryInsertedKeyAndNoOther) {
-  // Keys a stride of 2^21 apart (neighbouring cells along one axis) and a dense run, with the
-  // table at its fullest (half): every probe chain must end at the right slot or an empty one.
+  // Keys of neighbouring cells along each axis (VoxelGrid's keys: z in bits 0-20, y 21-41, x
+  // 42-62) and a dense run, with the table at its fullest (half): every probe chain must end
+  // at the right slot or an empty one.
   cvo::CellHashTable table;
   std::vector<std::uint64_t> keys;
   for (std::uint64_t k = 0; k < 1000; ++k)
     keys.push_back(k << 21);
+  for (std::uint64_t k = 1; k < 1000; ++k)
+    keys.push_back(k << 42);
   for (std::uint64_t k = 0; k < 24; ++k)
     keys.push_back((std::uint64_t{1} << 62) + k);
   table.reset(keys.size());
@@ -85,8 +88,10 @@ TEST(CellHashTable, FindsEveryInsertedKeyAndNoOther) {
     EXPECT_EQ(range->first, i);
     EXPECT_EQ(range->second, i + 1);
   }
-  for (std::uint64_t k = 0; k < 1000; ++k)
+  for (std::uint64_t k = 0; k < 1000; ++k) {
     EXPECT_EQ(table.find((k << 21) + 1), nullptr);
+    EXPECT_EQ(table.find((k << 42) + 3), nullptr);
+  }
   table.clear();
   EXPECT_EQ(table.find(keys[0]), nullptr);
 }

@@ -154,7 +154,7 @@ TEST(PhotometricRotation, ASmallCloudStillGetsItsRotation) {
 }
 
 TEST(PhotometricRotation, GivesTheSameRotationOnAnyThreadCount) {
-  // Points are handled in parallel but gathered in point order: bit-identical results.
+  // Points are handled in parallel, their sums added block by block in order: bit-identical.
   const TumPair pair = loadPair(17);
   const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 0.5);
   cvo::CvoParams params = presetParams();

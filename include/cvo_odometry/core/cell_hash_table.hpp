@@ -17,10 +17,14 @@ class CellHashTable {
   // Empties the table and sizes it for `cells` insertions.
   void reset(std::size_t cells) {
     std::size_t slots = 16;
-    while (slots < 2 * cells)
+    int bits = 4;
+    while (slots < 2 * cells) {
       slots *= 2;
+      ++bits;
+    }
     slots_.assign(slots, Slot{kEmpty, {0u, 0u}});
     mask_ = slots - 1;
+    shift_ = 64 - bits;
   }
 
   // `key` must be new and below 2^63 (VoxelGrid's keys: 21 bits an axis).
@@ -44,6 +48,7 @@ class CellHashTable {
   void clear() {
     slots_.clear();
     mask_ = 0;
+    shift_ = 64;
   }
 
  private:
@@ -54,12 +59,13 @@ class CellHashTable {
   };
 
   std::size_t slotOf(std::uint64_t key) const {
-    // Fibonacci hashing: neighbouring cells (keys differing in low bits of each axis) spread.
-    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & mask_;
+    // Fibonacci hashing: the product's top bits depend on every bit of the key (each axis).
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_);
   }
 
   std::vector<Slot> slots_;
-  std::size_t mask_ = 0;
+  std::size_t mask_ = 0;  // slots - 1 (a power of two)
+  int shift_ = 64;        // 64 - log2(slots)
 };
 
 }  // namespace cvo
