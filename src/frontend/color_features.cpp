@@ -39,15 +39,4 @@ void colorFeaturesAt(const cv::Mat& image, const cv::Mat& grey, int u, int v, fl
   out[4] = gy / 500.0f + 0.5f;
 }
 
-cv::Mat colorFeatures(const cv::Mat& image) {
-  const cv::Mat grey = toGrey(image);
-  cv::Mat features(image.size(), CV_32FC(5));
-  for (int v = 0; v < image.rows; ++v) {
-    float* out = features.ptr<float>(v);
-    for (int u = 0; u < image.cols; ++u)
-      colorFeaturesAt(image, grey, u, v, out + 5 * u);
-  }
-  return features;
-}
-
 }  // namespace cvo

@@ -219,22 +219,31 @@ TEST(RgbdFrontend, BadInputGetsAClearError) {
 
 }  // namespace
 
-TEST(RgbdFrontend, ColourFeaturesOfOnePixelAreThoseOfTheWholeImage) {
-  // The cloud builder computes the five values only at the selected pixels: they must be the
-  // feature image's, borders included, for colour and grey images alike.
+TEST(RgbdFrontend, ColourFeaturesAreColourAndCentralDifferences) {
+  // The five values at a pixel against OpenCV's own arithmetic: channels / 255 and central
+  // differences of the grey image with the border replicated, borders included, for colour and
+  // grey images alike.
   const TumFrame f = loadFrame(3);
   cv::Mat grey_image;
   cv::cvtColor(f.image, grey_image, cv::COLOR_BGR2GRAY);
   for (const cv::Mat& image : {f.image, grey_image}) {
-    const cv::Mat all = cvo::colorFeatures(image);
     const cv::Mat grey = cvo::toGrey(image);
+    cv::Mat grey_float, gx, gy;
+    grey.convertTo(grey_float, CV_32F);
+    const cv::Mat central = (cv::Mat_<float>(1, 3) << -0.5f, 0.0f, 0.5f);
+    cv::filter2D(grey_float, gx, CV_32F, central, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+    cv::filter2D(grey_float, gy, CV_32F, central.t(), cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
     for (const cv::Point p : {cv::Point(0, 0), cv::Point(639, 479), cv::Point(0, 200),
                               cv::Point(320, 0), cv::Point(123, 456), cv::Point(517, 31)}) {
       float one[5];
       cvo::colorFeaturesAt(image, grey, p.x, p.y, one);
-      for (int k = 0; k < 5; ++k) {
-        EXPECT_EQ(one[k], all.ptr<float>(p.y)[5 * p.x + k]) << p << " channel " << k;
+      for (int k = 0; k < 3; ++k) {
+        const int channel = image.channels() == 3 ? k : 0;
+        EXPECT_EQ(one[k], image.ptr<std::uint8_t>(p.y)[image.channels() * p.x + channel] / 255.0f)
+            << p << " channel " << k;
       }
+      EXPECT_EQ(one[3], gx.at<float>(p) / 500.0f + 0.5f) << p;
+      EXPECT_EQ(one[4], gy.at<float>(p) / 500.0f + 0.5f) << p;
     }
   }
 }
