@@ -106,7 +106,7 @@ PhotometricRotationResult refineRotationPhotometrically(
       }
       const double scale = std::max(kMadToSigma * median(magnitudes), 1e-6);
       const double huber = kHuberScale * scale;
-      const auto accumulate = [&](std::size_t b) {
+      forEachBlock(pool, blocks, [&](std::size_t b) {
         Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
         Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
         const std::size_t end = std::min(n, (b + 1) * kPointsPerBlock);
@@ -120,13 +120,7 @@ PhotometricRotationResult refineRotationPhotometrically(
         }
         block_H[b] = H;
         block_g[b] = g;
-      };
-      if (pool) {
-        pool->run(blocks, accumulate);
-      } else {
-        for (std::size_t b = 0; b < blocks; ++b)
-          accumulate(b);
-      }
+      });
       Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
       Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
       for (std::size_t b = 0; b < blocks; ++b) {

@@ -51,22 +51,26 @@ class BlockPool {
   std::vector<std::thread> helpers_;
 };
 
-// Calls item(i) for every i in [0, n), in blocks of `block_size` items on `pool`, or on this
-// thread alone when `pool` is null.
-template <class Item>
-void forEachInBlocks(BlockPool* pool, std::size_t n, std::size_t block_size, Item&& item) {
-  const auto block = [&](std::size_t b) {
-    const std::size_t end = std::min(n, (b + 1) * block_size);
-    for (std::size_t i = b * block_size; i < end; ++i)
-      item(i);
-  };
-  const std::size_t blocks = (n + block_size - 1) / block_size;
+// Calls block(b) for every b in [0, count) on `pool`, or on this thread alone, in order, when
+// `pool` is null.
+template <class Block>
+void forEachBlock(BlockPool* pool, std::size_t count, Block&& block) {
   if (pool == nullptr) {
-    for (std::size_t b = 0; b < blocks; ++b)
+    for (std::size_t b = 0; b < count; ++b)
       block(b);
     return;
   }
-  pool->run(blocks, block);
+  pool->run(count, block);
+}
+
+// Calls item(i) for every i in [0, n), in blocks of `block_size` items (forEachBlock).
+template <class Item>
+void forEachInBlocks(BlockPool* pool, std::size_t n, std::size_t block_size, Item&& item) {
+  forEachBlock(pool, (n + block_size - 1) / block_size, [&](std::size_t b) {
+    const std::size_t end = std::min(n, (b + 1) * block_size);
+    for (std::size_t i = b * block_size; i < end; ++i)
+      item(i);
+  });
 }
 
 }  // namespace cvo
