@@ -316,6 +316,7 @@ double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCl
                                      const Eigen::Isometry3d& T, double ell) {
   checkInputs(target, source);
   backend_->setProblem(target, source, params_);
+  target_stride_ = source_count_ = 0;  // the backend no longer holds align()'s clouds
   return backend_->oneOffMoments(T, ell).weight;
 }
 
