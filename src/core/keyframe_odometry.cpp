@@ -198,9 +198,15 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     const Eigen::Isometry3d view_from_reference =
         nearer ? last_good_->pose.inverse() * reference_pose_ : Eigen::Isometry3d::Identity();
     if (view.image() && cloud.image()) {
+      PhotometricTracks tracks;
+      if (priorConfident(frame.prior)) {
+        tracks.prior = &*frame.prior;
+        tracks.prior_from_reference =
+            pose_.inverse() * reference_pose_ * view_from_reference.inverse();
+      }
       PhotometricRotationResult refined = refineRotationPhotometrically(
           *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p,
-          &photometric_pool_);
+          &photometric_pool_, &tracks);
       a.result.transform = view_from_reference.inverse() * refined.transform;
       a.photometric = refined.report;
     } else {

@@ -306,6 +306,7 @@ cvo_odometry::CvoIndicator indicatorMsg(const PipelineResult& result, const ros:
   indicator.photometric_applied = update.photometric.applied;
   indicator.photometric_correction_deg = update.photometric.correction_deg;
   indicator.photometric_skipped = update.photometric.skipped;
+  indicator.photometric_tracks = static_cast<uint32_t>(update.photometric.tracks);
   indicator.registration_ms = update.report.time_ms;
   indicator.frontend_ms = result.stats.time_ms;
   indicator.total_ms = result.total_ms;

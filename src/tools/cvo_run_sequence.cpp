@@ -163,6 +163,9 @@ int main(int argc, char** argv) {
         } else if (update.photometric.applied) {
           std::cerr << ", photometric " << std::setprecision(3) << update.photometric.correction_deg
                     << " deg in " << update.photometric.iterations << " iterations";
+          if (update.photometric.tracks > 0) {
+            std::cerr << " with " << update.photometric.tracks << " tracks";
+          }
         }
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         if (!result.why.empty()) std::cerr << " [" << result.why << "]";

@@ -24,6 +24,7 @@ struct OdometryRun {
   cvo::Trajectory estimate, prior;
   std::vector<double> trusted;
   std::size_t tracked = 0, lost = 0;
+  std::size_t tracks_joined = 0;  // frames whose photometric stage weighed the feature tracks
 };
 
 struct Fixture {
@@ -93,6 +94,7 @@ OdometryRun run(const Fixture& fixture, std::size_t stride, const std::string& o
     out.estimate.append(fixture.stamps[k], r.update.pose);
     if (r.prior_pose) out.prior.append(fixture.stamps[k], *r.prior_pose);
     if (r.update.trusted()) out.trusted.push_back(fixture.stamps[k]);
+    out.tracks_joined += r.update.photometric.tracks > 0;
     out.tracked += r.update.state == cvo::TrackingState::kTracking ||
                    r.update.state == cvo::TrackingState::kRecovered;
     out.lost +=
@@ -145,6 +147,24 @@ TEST_P(KittiStrides, EveryPairTrackedAndRight) {
 
 INSTANTIATE_TEST_SUITE_P(Strides, KittiStrides,
                          testing::Combine(testing::Values(2, 3), testing::Bool()));
+
+// Stereo: the preset's photometric stage weighs the feature tracks beside the intensities and
+// keeps its translation. On the fixture's 8 frames at stride 1: 17.8 mm per frame against 21.9
+// with the intensities alone (51-frame excerpt: 14.1 against 18.0; README "Tracks in the
+// photometric stage").
+TEST(FastMotion, KittiTracksInThePhotometricStageImproveTheTranslation) {
+  const Fixture fixture = kitti();
+  const OdometryRun joined = run(fixture, 1, "");
+  const OdometryRun alone = run(fixture, 1, "photometric_tracks=false");
+  const auto with_tracks = evaluate(fixture, joined);
+  const auto without = evaluate(fixture, alone);
+  print("KITTI, tracks joined", with_tracks);
+  print("KITTI, intensities alone", without);
+  EXPECT_EQ(joined.tracks_joined, fixture.stamps.size() - 1);
+  EXPECT_EQ(alone.tracks_joined, 0u);
+  EXPECT_EQ(with_tracks.silent.failures, 0u);
+  EXPECT_LT(with_tracks.rpe_frame.translation_rmse, 0.9 * without.rpe_frame.translation_rmse);
+}
 
 class TumStrides : public testing::TestWithParam<std::tuple<int, bool>> {};
 

@@ -169,6 +169,42 @@ TEST(PhotometricRotation, GivesTheSameRotationOnAnyThreadCount) {
   }
 }
 
+// Tracks of the current cloud's own points, seen exactly where the ground truth puts them; their
+// points in the reference's frame (the prior tracked from the reference).
+cvo::MotionPrior exactTracks(const TumPair& pair, std::size_t count) {
+  cvo::MotionPrior prior;
+  prior.solved = true;
+  prior.focal_px = cvo::tumIntrinsics("fr1").fx;
+  for (std::size_t j = 0; j < pair.current.size(); j += pair.current.size() / count) {
+    const Eigen::Vector3d X = pair.current.position(j).cast<double>();
+    prior.points.push_back(pair.truth * X);
+    prior.observations.emplace_back(X.x() / X.z(), X.y() / X.z());
+  }
+  prior.inliers = prior.tracks = static_cast<int>(prior.points.size());
+  prior.inlier_ratio = 1.0;
+  return prior;
+}
+
+TEST(PhotometricRotation, TracksAreLeftOutWhenTheyCannotBeWeighed) {
+  // Fewer than 6 tracks in front of the camera: no scale for them, the intensities alone.
+  const TumPair pair = loadPair(17);
+  cvo::CvoParams params = presetParams();
+  params.photometric_tracks = true;
+  const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 0.5);
+  cvo::MotionPrior prior = exactTracks(pair, 400);
+  prior.points.resize(5);
+  prior.observations.resize(5);
+  const cvo::PhotometricTracks tracks{&prior, Eigen::Isometry3d::Identity()};
+  const cvo::PhotometricRotationResult few =
+      cvo::refineRotationPhotometrically(*pair.reference.image(), *pair.current.image(),
+                                         pair.current, guess, params, nullptr, &tracks);
+  const cvo::PhotometricRotationResult none = cvo::refineRotationPhotometrically(
+      *pair.reference.image(), *pair.current.image(), pair.current, guess, params);
+  ASSERT_TRUE(few.report.applied) << few.report.skipped;
+  EXPECT_EQ(few.report.tracks, 0u);
+  EXPECT_TRUE(few.transform.isApprox(none.transform, 0.0));
+}
+
 TEST(PhotometricRotation, KeepsTheGuessWhenItCannotOrMustNotCorrect) {
   const TumPair pair = loadPair(10);
   const Eigen::Isometry3d guess = rotatedGuess(pair.truth, 1.0);

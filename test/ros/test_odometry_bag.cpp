@@ -71,6 +71,9 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   pnh.param("max_rpe_mps", max_rpe_mps, max_rpe_mps);
   pnh.param("max_rpe_dps", max_rpe_dps, max_rpe_dps);
   pnh.param("timeout_s", timeout, timeout);
+  // Stereo preset: the photometric stage weighs the feature tracks on every tracked frame.
+  bool expect_photometric_tracks = false;
+  pnh.param("expect_photometric_tracks", expect_photometric_tracks, false);
 
   Collected collected;
   auto odom_sub =
@@ -145,6 +148,11 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     EXPECT_LE(indicator.cosine, 1.0 + 1e-9);
     EXPECT_GT(indicator.source_points, 1000u);
     EXPECT_GT(indicator.target_points, 1000u);
+    if (expect_photometric_tracks) {
+      EXPECT_GT(indicator.photometric_tracks, 20u) << "frame " << k;
+    } else {
+      EXPECT_EQ(indicator.photometric_tracks, 0u) << "frame " << k;
+    }
   }
   if (label_classes > 0) {
     const auto& cloud = collected.last_cloud;

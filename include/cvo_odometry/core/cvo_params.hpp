@@ -114,6 +114,9 @@ struct CvoParams {
   double photometric_max_correction = 2.0;
   // Keep the stage's translation too (where depth and image are simultaneous: stereo).
   bool photometric_translation = false;
+  // The feature prior's inlier tracks join the stage's alignment as reprojection errors, each
+  // set weighed by its robust scale (where depth and image are simultaneous: stereo).
+  bool photometric_tracks = false;
 
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;

@@ -110,6 +110,10 @@ void visitSettings(CvoParams& p, V&& v) {
   v(SettingInfo{"photometric_translation", "photometric",
                 "keep the stage's translation too (stereo: depth and image are simultaneous)"},
     p.photometric_translation);
+  v(SettingInfo{"photometric_tracks", "photometric",
+                "the feature prior's inlier tracks join the stage (stereo: depth and image are "
+                "simultaneous)"},
+    p.photometric_tracks);
   // Where the sums run
   v(SettingInfo{"backend", "backend", "auto: the GPU when one is usable, else the CPU"}, p.backend);
   v(SettingInfo{"num_threads", "backend", "CPU threads (0: all cores)", 0, 1024}, p.num_threads);

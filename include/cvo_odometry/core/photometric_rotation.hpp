@@ -19,6 +19,7 @@
 #include "cvo_odometry/core/cvo_params.hpp"
 #include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/core/motion_prior.hpp"
 
 namespace cvo {
 
@@ -29,12 +30,20 @@ struct PhotometricReport {
   std::size_t points = 0;       // points inside the reference image at the last iteration
   double correction_deg = 0.0;  // angle between CVO's rotation and the refined one
   double correlation = 0.0;     // of the cloud's intensities with the reference's at the result
+  std::size_t tracks = 0;       // feature tracks joined at the last iteration (0: none)
   double time_ms = 0.0;
 };
 
 struct PhotometricRotationResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // reference <- current
   PhotometricReport report;
+};
+
+// The feature prior's inlier tracks as a second set of residuals (CvoParams::photometric_tracks):
+// their points live in the frame the prior tracked from, `prior_from_reference` away.
+struct PhotometricTracks {
+  const MotionPrior* prior = nullptr;
+  Eigen::Isometry3d prior_from_reference = Eigen::Isometry3d::Identity();
 };
 
 // `reference_from_current`: CVO's estimate. Returns it unchanged (with `skipped` set) when the
@@ -46,6 +55,6 @@ struct PhotometricRotationResult {
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
     const Eigen::Isometry3d& reference_from_current, const CvoParams& params,
-    BlockPool* pool = nullptr);
+    BlockPool* pool = nullptr, const PhotometricTracks* tracks = nullptr);
 
 }  // namespace cvo
