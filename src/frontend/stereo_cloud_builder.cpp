@@ -1,12 +1,18 @@
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "cvo_odometry/frontend/depth_conversion.hpp"
 
 namespace cvo {
+
+namespace {
+constexpr int kMatchingContextRows = 16;
+}  // namespace
 
 StereoCloudBuilder::StereoCloudBuilder(const StereoFrontendOptions& options)
     : options_(options), matcher_(options.matcher), cloud_builder_(options.cloud) {
@@ -32,7 +38,21 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
     if (frame.right.empty()) {
       throw std::invalid_argument("stereo frame has neither a right image nor a disparity image");
     }
-    disparity = matcher_.disparity(frame.left, frame.right);
+    // Rows above crop_top_rows are never used (no point, no corner): only the rest is matched,
+    // with kMatchingContextRows above it for SGBM's top-down paths to settle. KITTI 06: the
+    // matching 22 % faster (49-51 -> 38-40 ms in the same minutes), per frame 14.13 / 31.56 /
+    // 51.49 -> 13.91 / 31.28 / 51.67 mm at strides 1 / 2 / 3 (README "A whole frame").
+    const int first = std::max(0, options_.cloud.crop_top_rows - kMatchingContextRows);
+    // (Pairs of different sizes go to the matcher whole, which refuses them by name.)
+    if (first > 0 && first < frame.left.rows && frame.left.size() == frame.right.size()) {
+      disparity =
+          cv::Mat(frame.left.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+      const cv::Range band(first, frame.left.rows);
+      matcher_.disparity(frame.left.rowRange(band), frame.right.rowRange(band))
+          .copyTo(disparity.rowRange(band));
+    } else {
+      disparity = matcher_.disparity(frame.left, frame.right);
+    }
     scale = 1.0;  // the matcher returns pixels
   }
   return disparityToMetres(disparity, frame.intrinsics.fx * frame.baseline, scale,

@@ -149,7 +149,7 @@ INSTANTIATE_TEST_SUITE_P(Strides, KittiStrides,
                          testing::Combine(testing::Values(2, 3), testing::Bool()));
 
 // Stereo: the preset's photometric stage weighs the feature tracks beside the intensities and
-// keeps its translation. On the fixture's 8 frames at stride 1: 17.8 mm per frame against 21.9
+// keeps its translation. On the fixture's 8 frames at stride 1: 17.5 mm per frame against 21.9
 // with the intensities alone (51-frame excerpt: 14.1 against 18.0; README "Tracks in the
 // photometric stage").
 TEST(FastMotion, KittiTracksInThePhotometricStageImproveTheTranslation) {

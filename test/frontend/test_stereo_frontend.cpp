@@ -162,6 +162,39 @@ TEST(StereoFrontend, MatchedAndGivenDisparityGiveSimilarDepth) {
   EXPECT_LT(relative[relative.size() / 2], 0.05) << "median relative depth difference";
 }
 
+// Matching skips the rows above crop_top_rows (but for 16 rows of context): no depth there, and
+// below it the depth of the whole pair's matching (SGBM's stripes differ, so not bit for bit).
+TEST(StereoFrontend, MatchingSkipsTheCroppedRows) {
+  cvo::OdometrySettings settings = kittiSettings();
+  ASSERT_EQ(settings.cloud.crop_top_rows, 100);
+  cvo::StereoFrame frame;
+  frame.left = readGrey(kPair + "/left.png");
+  frame.right = readGrey(kPair + "/right.png");
+  frame.intrinsics = pairIntrinsics();
+  frame.baseline = kPairBaseline;
+  const cv::Mat cropped = cvo::StereoCloudBuilder(settings.stereoOptions()).depth(frame);
+  settings.cloud.crop_top_rows = 0;
+  const cv::Mat whole = cvo::StereoCloudBuilder(settings.stereoOptions()).depth(frame);
+  for (int v = 0; v < 84; ++v)
+    for (int u = 0; u < cropped.cols; ++u)
+      ASSERT_FALSE(std::isfinite(cropped.at<float>(v, u))) << "row " << v << " was matched";
+  std::size_t both = 0, only_whole = 0, same = 0;
+  for (int v = 100; v < cropped.rows; ++v) {
+    for (int u = 0; u < cropped.cols; ++u) {
+      const float a = cropped.at<float>(v, u), b = whole.at<float>(v, u);
+      if (std::isfinite(a) && std::isfinite(b)) {
+        ++both;
+        same += std::abs(a - b) <= 0.01f * b;
+      } else if (std::isfinite(b)) {
+        ++only_whole;
+      }
+    }
+  }
+  ASSERT_GT(both, 200000u);
+  EXPECT_LT(only_whole, both / 50) << "the band loses depth the whole pair has";
+  EXPECT_GT(same, both * 95 / 100) << "depth within 1 % of the whole pair's";
+}
+
 TEST(DisparityConversion, EncodingsAndInvalidValues) {
   cv::Mat fixed_point = (cv::Mat_<std::int16_t>(1, 4) << 160, -16, 0, 320);  // OpenCV 16S
   const cv::Mat z = cvo::disparityToMetres(fixed_point, 100.0, 1.0 / 16.0, 0.5, 60.0);
