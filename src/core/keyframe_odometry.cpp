@@ -188,6 +188,9 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   a.good = check.good;
   a.problems = check.problems;
   if (!a.good) return a;
+  // The tracks' points are the previous frame's: the motion over this step is prior <- current.
+  const Eigen::Isometry3d prior_from_reference = pose_.inverse() * reference_pose_;
+  const Eigen::Isometry3d registered = a.result.transform;
   // Only a registration judged good is refined: a bad one is retried or lost anyway.
   if (p.photometric_rotation) {
     // The rotation is refined against the last good frame's image, the nearest view: its error
@@ -201,8 +204,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       PhotometricTracks tracks;
       if (priorConfident(frame.prior)) {
         tracks.prior = &*frame.prior;
-        tracks.prior_from_reference =
-            pose_.inverse() * reference_pose_ * view_from_reference.inverse();
+        tracks.prior_from_reference = prior_from_reference * view_from_reference.inverse();
       }
       PhotometricRotationResult refined = refineRotationPhotometrically(
           *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p,
@@ -217,9 +219,10 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   // prior too unsure to start from still vetoes (a fast jump tracks few corners, and a wrong
   // small motion can score a fair cosine).
   if (priorJudges(frame.prior)) {
-    // The tracks' points are the previous frame's: the registration's motion over this step.
+    // Judged on CVO's own motion when the tracks helped set the final one: a check they passed
+    // by pulling the pose their way would not be independent.
     const Eigen::Isometry3d prior_from_current =
-        pose_.inverse() * reference_pose_ * a.result.transform;
+        prior_from_reference * (a.photometric.tracks > 0 ? registered : a.result.transform);
     const TrackAgreement agreement =
         trackAgreement(*frame.prior, prior_from_current, p.track_agreement_px);
     a.agreement = agreement.fraction;

@@ -21,8 +21,10 @@ constexpr double kMinCorrelation = 0.5;
 
 // Points whose residuals share a cell of this size (px, in the current image) count as one
 // cluster when the tracks join: neighbouring intensities share their depth's and the image's
-// errors (KITTI 06: a design effect of 3.0 at 4 px cells, 4.6 at 8, 6.0 at 16, 7.5 at 32).
-constexpr double kClusterCellPx = 16.0;
+// errors. The cells must hold the correlation (KITTI 06's design effect still grows from 6.0 at
+// 16 px cells to 7.5 at 32) yet leave many clusters for the 6x6 M (~300 at 32 px on KITTI's
+// cropped image, ~300 at 640x480).
+constexpr double kClusterCellPx = 32.0;
 // Fewer clusters than this cannot estimate the intensities' 6x6 covariance: no tracks joined.
 constexpr std::size_t kMinClusters = 24;
 // The tracks' scale never falls below this (px): exact tracks would otherwise weigh infinitely.
@@ -41,7 +43,10 @@ PhotometricRotationResult refineRotationPhotometrically(
   auto finish = [&](const std::string& skipped) {
     report.skipped = skipped;
     report.applied = skipped.empty();
-    if (!report.applied) out.transform = reference_from_current;
+    if (!report.applied) {
+      out.transform = reference_from_current;
+      report.tracks = 0;  // nothing of theirs is kept
+    }
     report.time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return out;
@@ -86,24 +91,37 @@ PhotometricRotationResult refineRotationPhotometrically(
       const double w = huberWeight(std::abs(r), huber);
       cluster_g[point_cluster[j]] += w * r * point_jacobian[j];
     }
-    Matrix6d M = Matrix6d::Zero();
     std::size_t clusters = 0;
+    Vector6d mean = Vector6d::Zero();
     for (const Vector6d& cell : cluster_g) {
       if (cell.isZero(0.0)) continue;
-      M.noalias() += cell * cell.transpose();
+      mean += cell;
       ++clusters;
     }
     if (clusters < kMinClusters) return;
+    // Centred: at the joint estimate the intensities' own gradient need not vanish, and its
+    // mean must not count as their scatter.
+    mean /= static_cast<double>(clusters);
+    Matrix6d M = Matrix6d::Zero();
+    for (const Vector6d& cell : cluster_g) {
+      if (cell.isZero(0.0)) continue;
+      M.noalias() += (cell - mean) * (cell - mean).transpose();
+    }
     const Eigen::LDLT<Matrix6d> m_ldlt(M);
-    if (m_ldlt.info() != Eigen::Success || !(m_ldlt.vectorD().minCoeff() > 0.0)) return;
+    const auto pivots = m_ldlt.vectorD();
+    if (m_ldlt.info() != Eigen::Success || !(pivots.minCoeff() > 1e-12 * pivots.maxCoeff())) {
+      return;
+    }
     Matrix6d track_H = Matrix6d::Zero();
     Vector6d track_g = Vector6d::Zero();
-    if (!track_terms->addNormalEquations(T, kMinTrackScalePx, &track_H, &track_g)) return;
+    const std::size_t seen =
+        track_terms->addNormalEquations(T, kMinTrackScalePx, &track_H, &track_g);
+    if (seen == 0) return;
     const Matrix6d H_Minv = m_ldlt.solve(*H).transpose();  // H M^-1: H and M are symmetric
     const Matrix6d information = H_Minv * *H;
     *H = 0.5 * (information + information.transpose()) + track_H;
     *g = H_Minv * *g + track_g;
-    report.tracks = track_terms->size();
+    report.tracks = seen;
   };
   std::vector<double> magnitudes;  // |residual| of the observed points, for the median
   magnitudes.reserve(n);

@@ -7,6 +7,12 @@
 
 namespace cvo {
 
+namespace {
+// Huber's threshold on a 2-D error's length, in units of the per-component scale: 95 % of
+// Gaussian errors fall inside (sqrt of chi-square 2's 95 % point), as 1.345 sigma does in 1-D.
+constexpr double kHuberNormScale = 2.4477;
+}  // namespace
+
 TrackReprojection::TrackReprojection(const MotionPrior& prior,
                                      const Eigen::Isometry3d& prior_from_reference)
     : focal_px_(prior.focal_px) {
@@ -27,6 +33,7 @@ bool TrackReprojection::residual(std::size_t i, const Eigen::Isometry3d& referen
   if (!(X.z() > 0.0)) return false;
   const double inv_z = 1.0 / X.z();
   *error = focal_px_ * (X.head<2>() * inv_z - observations_[i]);
+  if (!error->allFinite()) return false;
   Eigen::Matrix<double, 2, 3> projection;
   projection << inv_z, 0.0, -X.x() * inv_z * inv_z, 0.0, inv_z, -X.y() * inv_z * inv_z;
   // (exp(xi) T)^-1 Z = T^-1 exp(-xi) Z, and exp(-xi) Z = Z + Z x omega - v to first order.
@@ -37,8 +44,9 @@ bool TrackReprojection::residual(std::size_t i, const Eigen::Isometry3d& referen
   return true;
 }
 
-bool TrackReprojection::addNormalEquations(const Eigen::Isometry3d& reference_from_current,
-                                           double min_scale_px, Matrix6d* H, Vector6d* g) {
+std::size_t TrackReprojection::addNormalEquations(const Eigen::Isometry3d& reference_from_current,
+                                                  double min_scale_px, Matrix6d* H, Vector6d* g) {
+  scale_px_ = 0.0;
   const std::size_t n = points_.size();
   errors_.resize(n);
   jacobians_.resize(n);
@@ -50,9 +58,10 @@ bool TrackReprojection::addNormalEquations(const Eigen::Isometry3d& reference_fr
     magnitudes_.push_back(std::abs(errors_[i].x()));
     magnitudes_.push_back(std::abs(errors_[i].y()));
   }
-  if (magnitudes_.size() < 12) return false;
+  const std::size_t seen = magnitudes_.size() / 2;
+  if (seen < 6) return 0;
   scale_px_ = std::max(kMadToSigma * medianInPlace(magnitudes_), min_scale_px);
-  const double huber = kHuberScale * scale_px_;
+  const double huber = kHuberNormScale * scale_px_;
   const double inverse_variance = 1.0 / (scale_px_ * scale_px_);
   for (std::size_t i = 0; i < n; ++i) {
     if (!in_front_[i]) continue;
@@ -60,7 +69,7 @@ bool TrackReprojection::addNormalEquations(const Eigen::Isometry3d& reference_fr
     H->noalias() += (w * jacobians_[i].transpose()) * jacobians_[i];
     g->noalias() += w * jacobians_[i].transpose() * errors_[i];
   }
-  return true;
+  return seen;
 }
 
 }  // namespace cvo

@@ -4,6 +4,7 @@
 // nothing added without enough tracks in front of the camera.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "cvo_odometry/core/lie_group.hpp"
@@ -87,7 +88,7 @@ TEST(TrackReprojection, GaussNewtonFindsTheMotionThroughNoiseAndOutliers) {
   for (int it = 0; it < 30; ++it) {
     cvo::Matrix6d H = cvo::Matrix6d::Zero();
     cvo::Vector6d g = cvo::Vector6d::Zero();
-    ASSERT_TRUE(tracks.addNormalEquations(T, 0.05, &H, &g));
+    ASSERT_EQ(tracks.addNormalEquations(T, 0.05, &H, &g), 300u);
     T = leftStep(-H.ldlt().solve(g), T);
   }
   const Eigen::Isometry3d error = s.truth.inverse() * T;
@@ -104,14 +105,24 @@ TEST(TrackReprojection, AddsNothingWithoutSixTracksInFront) {
   cvo::TrackReprojection few(s.prior, s.prior_from_reference);
   cvo::Matrix6d H = cvo::Matrix6d::Identity();
   cvo::Vector6d g = cvo::Vector6d::Zero();
-  EXPECT_FALSE(few.addNormalEquations(s.truth, 0.05, &H, &g));
+  EXPECT_EQ(few.addNormalEquations(s.truth, 0.05, &H, &g), 0u);
   EXPECT_EQ(H, cvo::Matrix6d::Identity());
   EXPECT_TRUE(g.isZero(0.0));
+  EXPECT_EQ(few.scalePx(), 0.0);
   // Turned away: every point behind the camera.
   const Scene all = makeScene(0.0, 0);
   cvo::TrackReprojection behind(all.prior, all.prior_from_reference);
   const Eigen::Isometry3d away = all.truth * cvo::lie::fromXyzRpy(0, 0, 0, 0, M_PI, 0);
-  EXPECT_FALSE(behind.addNormalEquations(away, 0.05, &H, &g));
+  EXPECT_EQ(behind.addNormalEquations(away, 0.05, &H, &g), 0u);
+  EXPECT_EQ(H, cvo::Matrix6d::Identity());
+  EXPECT_TRUE(g.isZero(0.0));
+  // A track that is not finite is left out, not summed.
+  Scene broken = makeScene(0.0, 0);
+  broken.prior.observations[3].x() = std::numeric_limits<double>::quiet_NaN();
+  cvo::TrackReprojection some(broken.prior, broken.prior_from_reference);
+  EXPECT_EQ(some.addNormalEquations(broken.truth, 0.05, &H, &g), 299u);
+  EXPECT_TRUE(H.allFinite());
+  EXPECT_TRUE(g.allFinite());
 }
 
 }  // namespace

@@ -130,8 +130,9 @@ void print(const char* what, const cvo::EvaluationReport& r) {
 class KittiStrides : public testing::TestWithParam<std::tuple<int, bool>> {};
 
 // Every pair tracked, no silent failure, with or without history, within 3 % of the step and
-// 0.35 deg on the fixture's frames 0-7 (measured 2.1 % / 0.20 deg at stride 2, 2.1 % / 0.29 deg
-// at stride 3; on the 51-frame excerpt 1.5 % and 0.10 / 0.14 deg: README "Fast motion").
+// 0.35 deg on the fixture's frames 0-7 (measured 41.6 mm / 0.21 deg at stride 2, 68.1 mm / 0.31
+// deg at stride 3, about 1.7 % and 1.9 % of the step; on the 51-frame excerpt 1.3 % and 1.5 %,
+// 0.10 / 0.15 deg: README "Large motions").
 TEST_P(KittiStrides, EveryPairTrackedAndRight) {
   const auto [stride, forget] = GetParam();
   const Fixture fixture = kitti();
@@ -149,8 +150,8 @@ INSTANTIATE_TEST_SUITE_P(Strides, KittiStrides,
                          testing::Combine(testing::Values(2, 3), testing::Bool()));
 
 // Stereo: the preset's photometric stage weighs the feature tracks beside the intensities and
-// keeps its translation. On the fixture's 8 frames at stride 1: 17.5 mm per frame against 21.9
-// with the intensities alone (51-frame excerpt: 14.1 against 18.0; README "Tracks in the
+// keeps its translation. On the fixture's 8 frames at stride 1: 16.7 mm per frame against 21.9
+// with the intensities alone (51-frame excerpt: 13.4 against 18.0; README "Tracks in the
 // photometric stage").
 TEST(FastMotion, KittiTracksInThePhotometricStageImproveTheTranslation) {
   const Fixture fixture = kitti();

@@ -13,8 +13,12 @@
 #include "cvo_odometry/core/params_io.hpp"
 #include "cvo_odometry/core/photometric_rotation.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/builtin_presets.hpp"
+#include "cvo_odometry/frontend/feature_tracker.hpp"
+#include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
+#include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
 namespace {
@@ -175,7 +179,8 @@ cvo::MotionPrior exactTracks(const TumPair& pair, std::size_t count) {
   cvo::MotionPrior prior;
   prior.solved = true;
   prior.focal_px = cvo::tumIntrinsics("fr1").fx;
-  for (std::size_t j = 0; j < pair.current.size(); j += pair.current.size() / count) {
+  const std::size_t step = std::max<std::size_t>(1, pair.current.size() / count);
+  for (std::size_t j = 0; j < pair.current.size(); j += step) {
     const Eigen::Vector3d X = pair.current.position(j).cast<double>();
     prior.points.push_back(pair.truth * X);
     prior.observations.emplace_back(X.x() / X.z(), X.y() / X.z());
@@ -183,6 +188,63 @@ cvo::MotionPrior exactTracks(const TumPair& pair, std::size_t count) {
   prior.inliers = prior.tracks = static_cast<int>(prior.points.size());
   prior.inlier_ratio = 1.0;
   return prior;
+}
+
+// Stereo (KITTI preset): the prior's real tracks from frame 4 to 5 join the stage and pull a
+// translation 11 cm off nearer the ground truth than the intensities alone do; the same pose on
+// any thread count.
+TEST(PhotometricRotation, KittiTracksJoinAndPullTheTranslationToTheTruth) {
+  const std::string folder = std::string(CVO_TEST_DATA_DIR) + "/kitti_06_stereo";
+  cvo::OdometrySettings settings;
+  cvo::applyPreset("kitti_stereo", &settings);
+  ASSERT_TRUE(settings.cvo.photometric_tracks && settings.cvo.photometric_translation);
+  const cvo::KittiSequence sequence(folder);
+  cvo::StereoCloudBuilder builder(settings.stereoOptions());
+  cvo::FeatureTracker tracker(settings.features);
+  const cvo::PinholeIntrinsics K = sequence.calibration().left;
+  cvo::LabeledCloud clouds[2];
+  cvo::MotionPrior prior;
+  for (int i = 0; i < 2; ++i) {
+    cvo::StereoFrame f;
+    sequence.load(4 + i, &f.left, &f.right, nullptr);
+    f.intrinsics = K;
+    f.baseline = sequence.calibration().baseline;
+    cvo::FrameImages images;  // as the pipeline gives them to the tracker
+    clouds[i] = builder.build(f, nullptr, &images);
+    prior = tracker.track(images.grey, images.depth, K, settings.cloud.crop_top_rows);
+  }
+  ASSERT_TRUE(prior.solved) << prior.problem << " tracks " << prior.tracks << " inliers "
+                            << prior.inliers;
+  ASSERT_TRUE(clouds[0].image() && clouds[1].image());
+  const cvo::Trajectory gt = cvo::readKittiTrajectory(folder + "/poses.txt");
+  const Eigen::Isometry3d truth = gt[4].pose.inverse() * gt[5].pose;
+  Eigen::Isometry3d guess = truth;
+  guess.translation() += Eigen::Vector3d(0.05, -0.02, 0.10);
+  const cvo::PhotometricTracks tracks{&prior, Eigen::Isometry3d::Identity()};  // from frame 4
+  auto refine = [&](const cvo::CvoParams& params, cvo::BlockPool* pool) {
+    return cvo::refineRotationPhotometrically(*clouds[0].image(), *clouds[1].image(), clouds[1],
+                                              guess, params, pool, &tracks);
+  };
+  cvo::CvoParams alone_params = settings.cvo;
+  alone_params.photometric_tracks = false;
+  const cvo::PhotometricRotationResult alone = refine(alone_params, nullptr);
+  const cvo::PhotometricRotationResult joined = refine(settings.cvo, nullptr);
+  ASSERT_TRUE(joined.report.applied) << joined.report.skipped;
+  EXPECT_EQ(alone.report.tracks, 0u);
+  EXPECT_GT(joined.report.tracks, 100u);
+  const double error = (joined.transform.translation() - truth.translation()).norm();
+  const double error_alone = (alone.transform.translation() - truth.translation()).norm();
+  std::cout << "translation error from 11 cm off: " << 1000 * error << " mm with "
+            << joined.report.tracks << " tracks, " << 1000 * error_alone << " mm without\n";
+  // Measured 11.7 against 16.4 mm; the stereo depth's ~1 % scale excess (README "Stereo scale":
+  // ~12 mm of this 1.2 m step) bounds both from below.
+  EXPECT_LT(error, 0.015);
+  EXPECT_LT(error, 0.8 * error_alone);
+  for (const int threads : {1, 3}) {
+    cvo::BlockPool pool(threads);
+    EXPECT_EQ(refine(settings.cvo, &pool).transform.matrix(), joined.transform.matrix())
+        << threads << " threads";
+  }
 }
 
 TEST(PhotometricRotation, TracksAreLeftOutWhenTheyCannotBeWeighed) {

@@ -149,6 +149,8 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     EXPECT_GT(indicator.source_points, 1000u);
     EXPECT_GT(indicator.target_points, 1000u);
     if (expect_photometric_tracks) {
+      EXPECT_TRUE(indicator.photometric_applied)
+          << "frame " << k << ": " << indicator.photometric_skipped;
       EXPECT_GT(indicator.photometric_tracks, 20u) << "frame " << k;
     } else {
       EXPECT_EQ(indicator.photometric_tracks, 0u) << "frame " << k;

@@ -23,17 +23,18 @@ class TrackReprojection {
 
   // Track i's error (px) where `reference_from_current` puts its point in the current image,
   // and its Jacobian for the left perturbation exp(xi) * reference_from_current, xi = [omega; v]
-  // (the photometric stage's); false when the point falls behind the camera.
+  // (the photometric stage's); false when the point falls behind the camera (or is not finite).
   bool residual(std::size_t i, const Eigen::Isometry3d& reference_from_current,
                 Eigen::Vector2d* error, Eigen::Matrix<double, 2, 6>* jacobian) const;
 
-  // Adds the tracks' normal equations (H += J^T W J, g += J^T W r) with Huber's weights over the
-  // variance of their own robust scale (MAD of the error components, at least `min_scale_px`).
-  // False, adding nothing, when fewer than 6 tracks are in front of the camera.
-  bool addNormalEquations(const Eigen::Isometry3d& reference_from_current, double min_scale_px,
-                          Matrix6d* H, Vector6d* g);
+  // Adds the tracks' normal equations (H += J^T W J, g += J^T W r) with Huber's weights (on the
+  // error's length) over the variance of their own robust scale (MAD of the error components,
+  // at least `min_scale_px`). Returns how many tracks were in front of the camera and added; 0,
+  // adding nothing, when fewer than 6 are.
+  std::size_t addNormalEquations(const Eigen::Isometry3d& reference_from_current,
+                                 double min_scale_px, Matrix6d* H, Vector6d* g);
 
-  double scalePx() const { return scale_px_; }  // of the last addNormalEquations, 0 before
+  double scalePx() const { return scale_px_; }  // of the last addNormalEquations; 0: none added
 
  private:
   std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> points_;  // reference
