@@ -117,6 +117,17 @@ TEST(RosConversions, IndicatorMessageFromAResult) {
   EXPECT_DOUBLE_EQ(msg.reference_stamp, 9.8);
   EXPECT_DOUBLE_EQ(msg.latency_ms, 12.5);
   EXPECT_EQ(msg.dropped_frames, 3u);
+  EXPECT_EQ(msg.photometric_tracks, 0u);
+
+  // A stereo frame whose photometric stage weighed the feature tracks.
+  result.update.state = cvo::TrackingState::kTracking;
+  result.update.photometric.applied = true;
+  result.update.photometric.correction_deg = 0.04;
+  result.update.photometric.tracks = 271;
+  const auto tracked = cvo::indicatorMsg(result, ros::Time(10.0), "odom", {});
+  EXPECT_TRUE(tracked.photometric_applied);
+  EXPECT_DOUBLE_EQ(tracked.photometric_correction_deg, 0.04);
+  EXPECT_EQ(tracked.photometric_tracks, 271u);
 }
 
 TEST(RosConversions, FramesFromMessagesRefuseWhatTheyCannotRead) {
