@@ -19,6 +19,8 @@ namespace {
 constexpr std::size_t kMinTracks = 8;
 // Pyramid levels of the backward (checking) track.
 constexpr int kBackwardLevels = 1;
+// Rows above the crop that the corner measure reads.
+constexpr int kCornerContextRows = 2;
 
 std::vector<cv::Point2f> normalised(const std::vector<cv::Point2f>& pixels,
                                     const PinholeIntrinsics& K) {
@@ -102,11 +104,18 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
                           int crop_top_rows, std::vector<cv::Mat> levels) {
   last_pyramid_ = std::move(levels);
   if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
-  cv::Mat mask = (depth == depth);  // NaN: no depth
-  mask.rowRange(0, std::min(std::max(crop_top_rows, 0), mask.rows)).setTo(0);
+  // Only the rows below the crop can hold a corner: the search runs there, with the 2 rows above
+  // that the corner measure (3x3 Sobel, 3x3 block) reads, so the corners are those of the whole
+  // image (KITTI: a quarter of the image skipped).
+  const int first = std::clamp(crop_top_rows - kCornerContextRows, 0, grey.rows);
+  const cv::Range band(first, grey.rows);
+  cv::Mat mask = (depth.rowRange(band) == depth.rowRange(band));  // NaN: no depth
+  mask.rowRange(0, std::clamp(crop_top_rows - first, 0, mask.rows)).setTo(0);
   std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(grey, corners, options_.max_corners, 0.01, options_.min_distance, mask, 3,
-                          false);
+  cv::goodFeaturesToTrack(grey.rowRange(band), corners, options_.max_corners, 0.01,
+                          options_.min_distance, mask, 3, false);
+  for (cv::Point2f& corner : corners)
+    corner.y += static_cast<float>(first);
   const std::vector<cv::Point2f> rays = normalised(corners, K);
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const float z = depth.at<float>(cvRound(corners[k].y), cvRound(corners[k].x));
