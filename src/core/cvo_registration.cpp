@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "cvo_odometry/core/backend_factory.hpp"
@@ -24,6 +25,14 @@ constexpr std::size_t kSelfProductPoints = 1000;
 constexpr int kNewtonStepsPerHessian = 3;
 // Relative fall of the smoothed F below which it counts as unchanged.
 constexpr double kFallTolerance = 1e-8;
+// At ell_min, pairs crossing the retain threshold can make the steps hop round a cycle of nearby
+// poses for ever (KITTI 06 reversed, stride 2: three poses 0.5 mm apart, MM steps of 6e-5-5e-4,
+// 10000 iterations and 500 ms before the limit). F rising by less than kStallRise of itself in
+// kStallIterations steps ends the level at the best pose seen. Converging frames keep rising by
+// ~1e-5 of F a step until eps_2 stops them (at most 79 iterations on the fixtures), so they are
+// never cut.
+constexpr int kStallIterations = 30;
+constexpr double kStallRise = 1e-6;
 
 }  // namespace
 
@@ -131,6 +140,10 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
   kernels::CurvatureSums curvature;  // the Hessian of the last curvature pass, this step's moments
   int hessian_uses = 0;              // Newton iterations since that pass
   bool last_newton_fresh = false;    // the last Newton step's Hessian was summed at its pose
+  // At ell_min: the highest smoothed F so far, where it was, and the steps since it rose.
+  std::optional<double> best_weight;
+  Eigen::Isometry3d best_pose = T;
+  int steps_since_rise = 0;
   report.message = "iteration limit reached";
   for (int it = 0; it < params_.max_iterations; ++it) {
     useCloudsForLengthscale(ell);
@@ -171,6 +184,19 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
                                                : 1.0;
     }
     previous_weight = smooth_weight;
+    if (ell <= params_.ell_min) {
+      if (!best_weight || smooth_weight > *best_weight + kStallRise * std::abs(*best_weight)) {
+        best_weight = smooth_weight;
+        best_pose = T;
+        steps_since_rise = 0;
+      } else if (++steps_since_rise >= kStallIterations) {
+        T = best_pose;
+        report.converged = true;
+        report.message = "converged: F rose no further in " + std::to_string(kStallIterations) +
+                         " steps (they hop across the retain threshold)";
+        break;
+      }
+    }
     const Vector6d step = lie::logSE3(weightedProcrustes(m));
     Vector6d newton;
     // Near the optimum MM steps converge linearly, slowly along weakly constrained directions;
