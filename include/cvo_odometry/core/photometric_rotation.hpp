@@ -8,6 +8,11 @@
 // current cloud's own intensities with the reference image (6-DoF, coarse blur level first,
 // Huber weights at 1.345 x the residuals' MAD scale), and only its rotation is kept: the
 // translation stays CVO's, which the depth observes better than the image does.
+//
+// Stereo, where depth and image are simultaneous (CvoParams::photometric_translation and
+// photometric_tracks): the stage keeps its translation too, and the feature prior's inlier tracks
+// join the intensities as reprojection errors (TrackReprojection), the intensities counted with
+// their cluster-robust information (README "Tracks in the photometric stage").
 #pragma once
 
 #include <cstddef>
@@ -50,8 +55,11 @@ struct PhotometricTracks {
 // images' levels differ, too few points (< params.min_tracking_points, divided by the point stride
 // of a blurred level) land in the reference image, the solve degenerates, the intensities correlate
 // below 0.5 at the result (the images do not show the same scene: a black frame, a covered lens),
-// or the correction exceeds params.photometric_max_correction. The points are evaluated on `pool`
-// (null: this thread); the result is the same on any thread count.
+// or the rotation's correction exceeds params.photometric_max_correction (the translation, kept
+// only with photometric_translation, has no bound of its own). `tracks` count only with
+// params.photometric_tracks, and only when at least 6 are in front and the intensities fill at
+// least 24 cells; report.tracks says how many joined. The points are evaluated on `pool` (null:
+// this thread); the result is the same on any thread count.
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
     const Eigen::Isometry3d& reference_from_current, const CvoParams& params,
