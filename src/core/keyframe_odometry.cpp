@@ -237,6 +237,21 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
           << " px) < min_track_agreement " << p.min_track_agreement;
       a.good = false;
       a.problems = why.str();
+    } else if (a.photometric.tracks > 0) {
+      // The stage's pose must agree with the tracks too: intensities that dragged it off them
+      // (the translation has no bound of its own) give way to CVO's pose.
+      const TrackAgreement final_agreement = trackAgreement(
+          *frame.prior, prior_from_reference * a.result.transform, p.track_agreement_px);
+      if (final_agreement.fraction < p.min_track_agreement) {
+        a.result.transform = registered;
+        a.photometric.applied = false;
+        a.photometric.tracks = 0;
+        std::ostringstream why;
+        why.precision(3);
+        why << "its pose disagrees with the feature tracks (" << 100.0 * final_agreement.fraction
+            << " % within " << p.track_agreement_px << " px)";
+        a.photometric.skipped = why.str();
+      }
     }
   }
   return a;

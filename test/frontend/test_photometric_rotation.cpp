@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -245,6 +246,56 @@ TEST(PhotometricRotation, KittiTracksJoinAndPullTheTranslationToTheTruth) {
     EXPECT_EQ(refine(settings.cvo, &pool).transform.matrix(), joined.transform.matrix())
         << threads << " threads";
   }
+}
+
+// The stage's pose must agree with the tracks as CVO's does: a reference image shifted sideways
+// (as a mis-rectified or mis-synchronised image could be) drags the joined solve off the tracks,
+// and the odometry keeps CVO's pose instead, still tracking.
+TEST(PhotometricRotation, AStagePoseOffTheTracksGivesWayToCvos) {
+  const std::string folder = std::string(CVO_TEST_DATA_DIR) + "/kitti_06_stereo";
+  cvo::OdometrySettings settings;
+  cvo::applyPreset("kitti_stereo", &settings);
+  settings.cvo.backend = cvo::BackendChoice::kCpu;
+  const cvo::KittiSequence sequence(folder);
+  cvo::StereoCloudBuilder builder(settings.stereoOptions());
+  cvo::FeatureTracker tracker(settings.features);
+  const cvo::PinholeIntrinsics K = sequence.calibration().left;
+  cvo::KeyframeOdometry odometry(settings.cvo);
+  // 4-8 px: the stage follows the image (shifts of 12 px and more fail its correlation check).
+  constexpr double shift_px = 6.0;
+  cvo::OdometryUpdate update;
+  for (int i = 0; i < 2; ++i) {
+    cvo::StereoFrame f;
+    sequence.load(4 + i, &f.left, &f.right, nullptr);
+    f.intrinsics = K;
+    f.baseline = sequence.calibration().baseline;
+    cvo::FrameImages images;
+    cvo::LabeledCloud cloud = builder.build(f, nullptr, &images);
+    cvo::OdometryFrame frame;
+    frame.stamp = 0.1 * i;
+    frame.prior = tracker.track(images.grey, images.depth, K, settings.cloud.crop_top_rows);
+    if (i == 1) {
+      // Few tracks, so that the intensities lead the joined solve.
+      ASSERT_TRUE(frame.prior->solved) << frame.prior->problem;
+      frame.prior->points.resize(12);
+      frame.prior->observations.resize(12);
+    }
+    if (i == 0) {  // the reference's image, which the stage aligns the current cloud to
+      cv::Mat shifted;
+      const cv::Mat move = (cv::Mat_<double>(2, 3) << 1, 0, shift_px, 0, 1, 0);
+      cv::warpAffine(f.left, shifted, move, f.left.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+      cloud.setImage(cvo::intensityImage(shifted, K, settings.cloud.image_levels));
+    }
+    frame.cloud = std::make_shared<const cvo::LabeledCloud>(std::move(cloud));
+    update = odometry.process(std::move(frame));
+  }
+  std::cout << "state " << cvo::toString(update.state) << ", photometric: "
+            << (update.photometric.applied ? "applied" : update.photometric.skipped) << ", "
+            << update.photometric.tracks << " tracks\n";
+  EXPECT_EQ(update.state, cvo::TrackingState::kTracking) << update.problem;
+  EXPECT_FALSE(update.photometric.applied);
+  EXPECT_NE(update.photometric.skipped.find("disagrees with the feature tracks"), std::string::npos)
+      << update.photometric.skipped;
 }
 
 TEST(PhotometricRotation, TracksAreLeftOutWhenTheyCannotBeWeighed) {
