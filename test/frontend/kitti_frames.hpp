@@ -19,13 +19,18 @@ inline cvo::PinholeIntrinsics pairIntrinsics() {
 }
 constexpr double kPairBaseline = 0.537;
 
-inline cvo::LabeledCloud kittiCloud(const cvo::KittiSequence& sequence,
-                                    cvo::StereoCloudBuilder& builder, std::size_t k) {
+// Frame k of a sequence as the stereo front end takes it.
+inline cvo::StereoFrame kittiFrame(const cvo::KittiSequence& sequence, std::size_t k) {
   cvo::StereoFrame f;
   sequence.load(k, &f.left, &f.right, nullptr);
   f.intrinsics = sequence.calibration().left;
   f.baseline = sequence.calibration().baseline;
-  return builder.build(f);
+  return f;
+}
+
+inline cvo::LabeledCloud kittiCloud(const cvo::KittiSequence& sequence,
+                                    cvo::StereoCloudBuilder& builder, std::size_t k) {
+  return builder.build(kittiFrame(sequence, k));
 }
 
 }  // namespace cvo_test

@@ -21,6 +21,7 @@
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
+#include "kitti_frames.hpp"
 
 namespace {
 
@@ -206,10 +207,7 @@ TEST(PhotometricRotation, KittiTracksJoinAndPullTheTranslationToTheTruth) {
   cvo::LabeledCloud clouds[2];
   cvo::MotionPrior prior;
   for (int i = 0; i < 2; ++i) {
-    cvo::StereoFrame f;
-    sequence.load(4 + i, &f.left, &f.right, nullptr);
-    f.intrinsics = K;
-    f.baseline = sequence.calibration().baseline;
+    const cvo::StereoFrame f = cvo_test::kittiFrame(sequence, 4 + i);
     cvo::FrameImages images;  // as the pipeline gives them to the tracker
     clouds[i] = builder.build(f, nullptr, &images);
     prior = tracker.track(images.grey, images.depth, K, settings.cloud.crop_top_rows);
@@ -265,10 +263,7 @@ TEST(PhotometricRotation, AStagePoseOffTheTracksGivesWayToCvos) {
   constexpr double shift_px = 6.0;
   cvo::OdometryUpdate update;
   for (int i = 0; i < 2; ++i) {
-    cvo::StereoFrame f;
-    sequence.load(4 + i, &f.left, &f.right, nullptr);
-    f.intrinsics = K;
-    f.baseline = sequence.calibration().baseline;
+    const cvo::StereoFrame f = cvo_test::kittiFrame(sequence, 4 + i);
     cvo::FrameImages images;
     cvo::LabeledCloud cloud = builder.build(f, nullptr, &images);
     cvo::OdometryFrame frame;
