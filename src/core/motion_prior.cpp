@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "cvo_odometry/core/robust_scale.hpp"
+
 namespace cvo {
 
 TrackAgreement trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d& motion,
@@ -23,10 +25,8 @@ TrackAgreement trackAgreement(const MotionPrior& prior, const Eigen::Isometry3d&
   const auto within =
       std::count_if(errors.begin(), errors.end(), [&](double e) { return e <= max_error_px; });
   agreement.fraction = static_cast<double>(within) / static_cast<double>(errors.size());
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  agreement.median_px = errors[errors.size() / 2];
-  std::nth_element(flows.begin(), flows.begin() + flows.size() / 2, flows.end());
-  agreement.median_flow_px = flows[flows.size() / 2];
+  agreement.median_px = medianInPlace(errors);
+  agreement.median_flow_px = medianInPlace(flows);
   return agreement;
 }
 

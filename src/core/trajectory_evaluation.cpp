@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/robust_scale.hpp"
 
 namespace cvo {
 
@@ -98,8 +99,7 @@ AteResult computeAte(const AssociatedPoses& poses) {
     sum += e;
   result.mean = sum / static_cast<double>(n);
   result.max = *std::max_element(errors.begin(), errors.end());
-  std::nth_element(errors.begin(), errors.begin() + n / 2, errors.end());
-  result.median = errors[n / 2];
+  result.median = medianInPlace(errors);
   return result;
 }
 
@@ -117,8 +117,7 @@ RpeResult computeRpeFixedDelta(const AssociatedPoses& poses, double delta_s) {
   std::vector<double> intervals;
   for (std::size_t i = 0; i + 1 < n; ++i)
     intervals.push_back(poses.stamps[i + 1] - poses.stamps[i]);
-  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
-  const double tolerance = std::max(0.5 * intervals[intervals.size() / 2], 1e-3);
+  const double tolerance = std::max(0.5 * medianInPlace(intervals), 1e-3);
   for (std::size_t i = 0; i < n; ++i) {
     const double wanted = poses.stamps[i] + delta_s;
     auto it = std::lower_bound(poses.stamps.begin() + i, poses.stamps.end(), wanted);

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <vector>
 
+#include "cvo_odometry/core/robust_scale.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 #include "cvo_odometry/tools/tool_options.hpp"
 #include "cvo_odometry/tools/tracking_tally.hpp"
@@ -40,8 +41,7 @@ std::size_t pingPong(std::size_t k, std::size_t n) {
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
+  return cvo::medianInPlace(v);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
-// Robust statistics shared by the image-based solvers (photometric stage, feature tracks): the
-// residuals' scale from their median absolute value and Huber's weights at 1.345 of it.
+// Robust statistics: the median (the upper one for an even count) that the image-based solvers
+// (photometric stage, feature tracks), the tracks' agreement, the trajectory evaluation and the
+// stamp pairer use, and the solvers' residual scale and Huber weights.
 #pragma once
 
 #include <algorithm>

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "cvo_odometry/core/robust_scale.hpp"
+
 namespace cvo {
 
 struct StampPairerOptions {
@@ -121,11 +123,7 @@ class OrderedStampPairer {
   template <class T>
   using Queue = std::deque<Stamped<T>>;
 
-  static double median(std::vector<double> values) {
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-  }
+  static double median(std::vector<double> values) { return medianInPlace(values); }
 
   template <class T>
   static double medianSpacing(const Queue<T>& queue) {
