@@ -121,7 +121,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   FrontendStats local;
   const auto pixels = selector_.select(grey, valid, &local.selection);
 
-  const auto rays = normalisedRays(pixels, intrinsics);
+  const auto rays = rays_.rays(pixels, intrinsics);
   LabeledCloud cloud(true, options_.semantic_classes);
   cloud.reserve(pixels.size());
   std::vector<float> probabilities(

@@ -11,6 +11,7 @@
 
 #include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/ray_table.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
@@ -150,6 +151,28 @@ TEST(RgbdFrontend, DistortionModelMovesRaysOffCentre) {
   const auto pinhole = cvo::normalisedRays(pixels, pinholeFr1());
   EXPECT_NEAR(distorted[0].x, pinhole[0].x, 1e-3);  // near the centre: the same ray
   EXPECT_GT(std::abs(distorted[1].x - pinhole[1].x), 0.01);
+}
+
+TEST(RgbdFrontend, RayTableGivesEachPixelsOwnUndistortedRay) {
+  const cvo::PinholeIntrinsics fr1 = cvo::tumIntrinsics("fr1");
+  const std::vector<cv::Point> pixels{{0, 0}, {639, 479}, {318, 255}, {20, 451}, {600, 3}};
+  cvo::RayTable table;
+  const auto looked_up = table.rays(pixels, fr1);
+  ASSERT_EQ(looked_up.size(), pixels.size());
+  for (std::size_t k = 0; k < pixels.size(); ++k) {
+    const auto alone = cvo::normalisedRays({pixels[k]}, fr1);
+    EXPECT_EQ(looked_up[k], alone[0]) << "pixel " << pixels[k];  // bit for bit
+  }
+  // Other intrinsics: a new table, not the old one's rays.
+  cvo::PinholeIntrinsics other = fr1;
+  other.distortion[0] = -0.1;
+  const auto changed = table.rays(pixels, other);
+  const auto direct = cvo::normalisedRays(pixels, other);
+  for (std::size_t k = 0; k < pixels.size(); ++k)
+    EXPECT_EQ(changed[k], direct[k]) << "pixel " << pixels[k];
+  EXPECT_GT(std::abs(changed[0].x - looked_up[0].x), 1e-3);
+  // No distortion: computed directly.
+  EXPECT_EQ(table.rays(pixels, pinholeFr1()), cvo::normalisedRays(pixels, pinholeFr1()));
 }
 
 void expectError(const std::function<void()>& call, const std::string& words) {

@@ -11,6 +11,7 @@
 #include "cvo_odometry/core/labeled_cloud.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 #include "cvo_odometry/frontend/point_selector.hpp"
+#include "cvo_odometry/frontend/ray_table.hpp"
 
 namespace cvo {
 
@@ -71,6 +72,7 @@ class DepthCloudBuilder {
  private:
   CloudBuilderOptions options_;
   PointSelector selector_;
+  RayTable rays_;
 };
 
 }  // namespace cvo

@@ -16,6 +16,11 @@ struct PinholeIntrinsics {
   // length, principal point far outside the image, zero size, a distortion coefficient count
   // no model has, non-finite coefficients).
   void validate() const;
+
+  bool operator==(const PinholeIntrinsics& other) const {
+    return fx == other.fx && fy == other.fy && cx == other.cx && cy == other.cy &&
+           width == other.width && height == other.height && distortion == other.distortion;
+  }
 };
 
 }  // namespace cvo
