@@ -21,7 +21,7 @@ struct FeatureTrackerOptions {
   bool enabled = true;
   int max_corners = 500;
   double min_distance = 12.0;   // px between corners
-  int window = 15;              // KLT window (px)
+  int window = 11;              // KLT window (px)
   int levels = 4;               // pyramid levels above the image
   double max_flow_error = 1.0;  // px, forward-backward
   double ransac_px = 1.5;       // PnP inlier threshold (px)
