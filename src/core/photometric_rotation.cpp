@@ -125,6 +125,7 @@ PhotometricRotationResult refineRotationPhotometrically(
   };
   std::vector<double> magnitudes;  // |residual| of the observed points, for the median
   magnitudes.reserve(n);
+  std::vector<double> median_scratch;
   const std::size_t blocks = (n + kPointsPerBlock - 1) / kPointsPerBlock;
   // Each block's share of the normal equations, summed in block order.
   std::vector<Eigen::Matrix<double, 6, 6>> block_H(blocks);
@@ -149,6 +150,7 @@ PhotometricRotationResult refineRotationPhotometrically(
                            static_cast<std::size_t>(p.x() / kClusterCellPx);
       }
     });
+    double median = 0.0;  // of the level's last iteration: the next one's is near it
     for (int it = 0; it < params.photometric_iterations; ++it) {
       forEachInBlocks(pool, n, kPointsPerBlock, [&](std::size_t j) {
         point_residual[j] = NAN;
@@ -174,7 +176,8 @@ PhotometricRotationResult refineRotationPhotometrically(
                       std::to_string((n + stride - 1) / stride) +
                       " points inside the reference image at blur level " + std::to_string(level));
       }
-      const double scale = std::max(kMadToSigma * medianInPlace(magnitudes), 1e-6);
+      median = medianNear(magnitudes, median, median_scratch);
+      const double scale = std::max(kMadToSigma * median, 1e-6);
       const double huber = kHuberScale * scale;
       forEachBlock(pool, blocks, [&](std::size_t b) {
         Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();

@@ -19,6 +19,31 @@ inline double medianInPlace(std::vector<double>& values) {
   return *middle;
 }
 
+// medianInPlace's value, found faster when `guess` lies near it (an iterative solver's last
+// scale): only the values within 10 % of the guess are ordered, the whole set when the median
+// is not among them. Exact either way. `values` may be reordered; `scratch` is reused storage.
+inline double medianNear(std::vector<double>& values, double guess, std::vector<double>& scratch) {
+  const std::size_t k = values.size() / 2;
+  if (guess > 0.0 && std::isfinite(guess)) {
+    const double low = 0.9 * guess, high = 1.1 * guess;
+    scratch.resize(values.size());
+    std::size_t below = 0, inside = 0;
+    // Branchless: which side a value falls on is a coin toss near the median.
+    for (const double v : values) {
+      below += v < low ? 1 : 0;
+      scratch[inside] = v;
+      inside += v >= low && v <= high ? 1 : 0;
+    }
+    if (below <= k && k < below + inside) {
+      const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(k - below);
+      std::nth_element(scratch.begin(), middle,
+                       scratch.begin() + static_cast<std::ptrdiff_t>(inside));
+      return *middle;
+    }
+  }
+  return medianInPlace(values);
+}
+
 // Huber's weight of a residual of size `magnitude` at threshold `huber`.
 inline double huberWeight(double magnitude, double huber) {
   return magnitude <= huber ? 1.0 : huber / magnitude;
