@@ -5,28 +5,38 @@
 namespace cvo {
 
 std::uint64_t imageFingerprint(const cv::Mat& image) {
-  // FNV-1a over 64-bit words (and the tail bytes), seeded with the shape.
+  // FNV-1a over 64-bit words in four interleaved lanes (one lane's multiply chain would take
+  // ~4 cycles a word: 0.3 ms for a TUM frame's two images), the tail bytes, the shape, then the
+  // lanes folded together.
   constexpr std::uint64_t kPrime = 0x100000001b3ULL;
+  constexpr int kLanes = 4;
+  std::uint64_t lanes[kLanes];
+  for (int l = 0; l < kLanes; ++l)
+    lanes[l] = 0xcbf29ce484222325ULL + static_cast<std::uint64_t>(l);
   std::uint64_t h = 0xcbf29ce484222325ULL;
-  const auto mix = [&](std::uint64_t word) {
-    h ^= word;
-    h *= kPrime;
+  const auto mix = [&](std::uint64_t& hash, std::uint64_t word) {
+    hash ^= word;
+    hash *= kPrime;
   };
-  mix(static_cast<std::uint64_t>(image.rows));
-  mix(static_cast<std::uint64_t>(image.cols));
-  mix(static_cast<std::uint64_t>(image.type()));
+  mix(h, static_cast<std::uint64_t>(image.rows));
+  mix(h, static_cast<std::uint64_t>(image.cols));
+  mix(h, static_cast<std::uint64_t>(image.type()));
   const std::size_t row_bytes = image.cols * image.elemSize();
   for (int r = 0; r < image.rows; ++r) {
     const unsigned char* row = image.ptr<unsigned char>(r);
     std::size_t k = 0;
-    for (; k + 8 <= row_bytes; k += 8) {
-      std::uint64_t word;
-      std::memcpy(&word, row + k, 8);
-      mix(word);
+    for (; k + 8 * kLanes <= row_bytes; k += 8 * kLanes) {
+      for (int l = 0; l < kLanes; ++l) {
+        std::uint64_t word;
+        std::memcpy(&word, row + k + 8 * l, 8);
+        mix(lanes[l], word);
+      }
     }
     for (; k < row_bytes; ++k)
-      mix(row[k]);
+      mix(h, row[k]);
   }
+  for (const std::uint64_t lane : lanes)
+    mix(h, lane);
   return h;
 }
 

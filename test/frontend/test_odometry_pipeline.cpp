@@ -28,6 +28,31 @@ cvo::RgbdFrame tumFrame(const cvo::TumSequence& sequence, std::size_t k) {
   return frame;
 }
 
+TEST(OdometryPipeline, AnyChangedByteChangesTheFingerprint) {
+  const cvo::TumSequence sequence(kTum);
+  const cvo::RgbdFrame frame = tumFrame(sequence, 0);
+  // 641 columns: rows whose bytes end in a tail shorter than the four lanes' 32 bytes.
+  cv::Mat image;
+  cv::copyMakeBorder(frame.image, image, 0, 0, 0, 1, cv::BORDER_REPLICATE);
+  const std::uint64_t original = cvo::imageFingerprint(image);
+  EXPECT_EQ(cvo::imageFingerprint(image.clone()), original);  // content, not the buffer
+  const std::size_t row_bytes = image.cols * image.elemSize();
+  // Each lane of a 32-byte run, a byte of a word's middle, the tail, the last row.
+  for (const auto& [row, byte] : std::vector<std::pair<int, std::size_t>>{
+           {0, 0}, {0, 8}, {0, 16}, {0, 27}, {5, row_bytes - 1}, {image.rows - 1, 100}}) {
+    cv::Mat changed = image.clone();
+    changed.ptr<unsigned char>(row)[byte] ^= 1;
+    EXPECT_NE(cvo::imageFingerprint(changed), original) << "row " << row << ", byte " << byte;
+  }
+  // Two rows swapped: the same bytes elsewhere.
+  cv::Mat swapped = image.clone();
+  image.row(1).copyTo(swapped.row(2));
+  image.row(2).copyTo(swapped.row(1));
+  EXPECT_NE(cvo::imageFingerprint(swapped), original);
+  // The same bytes in another shape or type.
+  EXPECT_NE(cvo::imageFingerprint(image.reshape(1)), original);
+}
+
 TEST(OdometryPipeline, RepeatedImagesAreStaleAndChangeNothingElse) {
   const cvo::TumSequence sequence(kTum);
   const auto stamp = [&](std::size_t k) { return sequence.frames()[k].depth_stamp; };
