@@ -102,24 +102,23 @@ CVO_CPU_DISPATCH kernels::PointCurvature curvatureOfCandidates(
 
 }  // namespace
 
-void CpuBackend::Block::clear() {
-  resize(0);
-}
-
-void CpuBackend::Block::resize(std::size_t n) {
-  for (auto* v : {&x, &y, &z})
-    v->resize(n);
-  if (!appearance.empty()) {
-    appearance.resize(n);
-    appearance_d2.resize(n);
+void CpuBackend::Block::reserve(std::size_t n, bool with_appearance) {
+  if (n > x.size()) {
+    const std::size_t grown = std::max(n, 2 * x.size());
+    for (auto* v : {&x, &y, &z})
+      v->resize(grown);
+  }
+  if (with_appearance && n > appearance.size()) {
+    appearance.resize(x.size());
+    appearance_d2.resize(x.size());
   }
 }
 
-void CpuBackend::Block::move(std::size_t from, std::size_t to) {
+void CpuBackend::Block::move(std::size_t from, std::size_t to, bool with_appearance) {
   x[to] = x[from];
   y[to] = y[from];
   z[to] = z[from];
-  if (!appearance.empty()) {
+  if (with_appearance) {
     appearance[to] = appearance[from];
     appearance_d2[to] = appearance_d2[from];
   }
@@ -241,9 +240,9 @@ void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float 
       // Every slot of the range written, the next one's start moved on only past a kept point:
       // no branch to mispredict (about a third of a range is kept).
       grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
-        std::size_t kept = block.size();
-        block.resize(kept + (last - first));
+        block.reserve(block.count + (last - first), false);
         float *bx = block.x.data(), *by = block.y.data(), *bz = block.z.data();
+        std::size_t kept = block.count;
         for (std::uint32_t k = first; k < last; ++k) {
           const float dx = xs[k] - z[0], dy = ys[k] - z[1], dz = zs[k] - z[2];
           bx[kept] = xs[k];
@@ -251,7 +250,7 @@ void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float 
           bz[kept] = zs[k];
           kept += dx * dx + dy * dy + dz * dz <= radius2 ? 1 : 0;
         }
-        block.resize(kept);
+        block.count = kept;
       });
     } else {
       grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
@@ -285,12 +284,12 @@ void CpuBackend::refilterBlock(std::size_t b, const float* pose, double ell, dou
       const float x[3] = {block.x[c], block.y[c], block.z[c]};
       const float d2 = kernels::squaredDistance(x, z, 3) * inv_ell2;
       if (d2 + (constant_appearance_ ? 0.0f : block.appearance_d2[c]) >= reach2) continue;
-      block.move(c, kept++);
+      block.move(c, kept++, !constant_appearance_);
     }
     first = last;
     block.offsets[k + 1] = kept;
   }
-  block.resize(kept);
+  block.count = kept;
   block.setExtent(transformed, points);
 }
 

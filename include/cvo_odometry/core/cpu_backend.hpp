@@ -33,9 +33,12 @@ class CpuBackend : public RegistrationBackend {
   // appearance is the same constant: the appearance arrays stay empty.
   struct Block {
     std::vector<std::uint32_t> offsets;  // size = points in block + 1
-    std::vector<float> x, y, z;          // the target point, copied: unit-stride loads vectorise
-    std::vector<float> appearance;       // s^2 times the appearance factors of the pair
-    std::vector<float> appearance_d2;    // scaled appearance distance (pose independent)
+    // The list is the first `count` entries; the arrays keep their largest size, so that a
+    // rebuild writes each entry once instead of zero-filling it first.
+    std::size_t count = 0;
+    std::vector<float> x, y, z;        // the target point, copied: unit-stride loads vectorise
+    std::vector<float> appearance;     // s^2 times the appearance factors of the pair
+    std::vector<float> appearance_d2;  // scaled appearance distance (pose independent)
     // The list holds every pair within sqrt(cutoff) + margin (scaled) at `pose` and `ell`.
     bool listed = false;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -47,21 +50,21 @@ class CpuBackend : public RegistrationBackend {
     // centre and spread of `count` transformed points (x, y, z interleaved).
     void setExtent(const float* transformed, std::size_t count);
 
-    std::size_t size() const { return x.size(); }
-    void clear();
-    void push(float px, float py, float pz) {
-      x.push_back(px);
-      y.push_back(py);
-      z.push_back(pz);
-    }
+    std::size_t size() const { return count; }
+    void clear() { count = 0; }
+    // Room for n entries (the appearance arrays too when `with_appearance`).
+    void reserve(std::size_t n, bool with_appearance);
     void push(float px, float py, float pz, float weight, float distance2) {
-      push(px, py, pz);
-      appearance.push_back(weight);
-      appearance_d2.push_back(distance2);
+      reserve(count + 1, true);
+      x[count] = px;
+      y[count] = py;
+      z[count] = pz;
+      appearance[count] = weight;
+      appearance_d2[count] = distance2;
+      ++count;
     }
-    // Keeps candidate `from` at slot `to` (to <= from).
-    void move(std::size_t from, std::size_t to);
-    void resize(std::size_t n);
+    // Keeps candidate `from` at slot `to` (to <= from), with its appearance when `with_appearance`.
+    void move(std::size_t from, std::size_t to, bool with_appearance);
   };
 
   // How far any point of the block can have moved between its listing pose and T.
