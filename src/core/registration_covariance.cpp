@@ -13,15 +13,27 @@ Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
   const Matrix6d unknown = Matrix6d::Identity() * 1e6;
   if (source.size() < 3 || !(lengthscale > 0.0)) return unknown;
-  // J = d(T p)/d(t, w) for a left perturbation: [I, -[Tp]x].
-  Matrix6d information = Matrix6d::Zero();
+  // J = d(T p)/d(t, w) for a left perturbation: [I, -[Tp]x], so that the sum of J^T J over the
+  // points is [[n I, -[s]x], [[s]x, (sum |p|^2) I - sum p p^T]] with s = sum p (p = T p): ten
+  // sums instead of a 6x6 product per point.
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < source.size(); ++i) {
     const Eigen::Vector3d p = T * source.position(i).cast<double>();
-    Eigen::Matrix<double, 3, 6> J;
-    J.leftCols<3>().setIdentity();
-    J.rightCols<3>() << 0, p.z(), -p.y(), -p.z(), 0, p.x(), p.y(), -p.x(), 0;
-    information.noalias() += J.transpose() * J;
+    sum += p;
+    scatter.noalias() += p * p.transpose();
   }
+  const auto skew = [](const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+  };
+  Matrix6d information;
+  information.topLeftCorner<3, 3>() =
+      static_cast<double>(source.size()) * Eigen::Matrix3d::Identity();
+  information.topRightCorner<3, 3>() = -skew(sum);
+  information.bottomLeftCorner<3, 3>() = skew(sum);
+  information.bottomRightCorner<3, 3>() = scatter.trace() * Eigen::Matrix3d::Identity() - scatter;
   information /= lengthscale * lengthscale;
   const Eigen::LDLT<Matrix6d> ldlt(information);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||

@@ -37,6 +37,26 @@ TEST(RegistrationCovariance, PositiveDefiniteAndScalesAsExpected) {
               1e-9 * c.trace());
 }
 
+// The information from its ten sums is the sum of every point's J^T J, J = [I, -[T p]x].
+TEST(RegistrationCovariance, IsTheInverseOfThePointsJacobianProducts) {
+  const auto cloud = randomCloud(500, 3);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  T.translation() << 0.3, -0.2, 1.5;
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = T * cloud.position(i).cast<double>();
+    Eigen::Matrix<double, 3, 6> J;
+    J.leftCols<3>().setIdentity();
+    J.rightCols<3>() << 0, p.z(), -p.y(), -p.z(), 0, p.x(), p.y(), -p.x(), 0;
+    information += J.transpose() * J;
+  }
+  const double ell = 0.05;
+  const Eigen::Matrix<double, 6, 6> expected = (information / (ell * ell)).inverse();
+  const auto c = cvo::registrationCovariance(cloud, T, ell, 1.0);
+  EXPECT_LT((c - expected).norm(), 1e-9 * expected.norm()) << c << "\n\n" << expected;
+}
+
 TEST(RegistrationCovariance, DegenerateCloudsAreUnknown) {
   cvo::LabeledCloud line(false);
   for (int i = 0; i < 100; ++i)
