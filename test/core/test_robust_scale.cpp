@@ -17,7 +17,7 @@ TEST(RobustScale, MedianNearIsTheMedianWhateverTheGuess) {
   std::mt19937 random(7);
   std::normal_distribution<double> noise(0.0, 0.05);
   std::vector<double> scratch;
-  for (const std::size_t count : {1u, 2u, 3u, 10u, 11u, 1000u, 9001u}) {
+  for (const std::size_t count : {1u, 2u, 3u, 10u, 11u, 1000u, 1023u, 1024u, 9001u}) {
     std::vector<double> values(count);
     for (double& v : values)
       v = std::abs(noise(random));
@@ -31,6 +31,15 @@ TEST(RobustScale, MedianNearIsTheMedianWhateverTheGuess) {
           << count << " values, guess " << guess << " for " << median;
     }
   }
+}
+
+TEST(RobustScale, MedianNearIsExactWhenItsOwnSampleMisleadsIt) {
+  // Every 16th value (the sample a guess-less call orders) far above the rest.
+  std::vector<double> values(4000), scratch;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = i % 16 == 0 ? 100.0 + static_cast<double>(i) : 0.001 * static_cast<double>(i % 97);
+  const double median = plainMedian(values);
+  EXPECT_EQ(cvo::medianNear(values, 0.0, scratch), median);
 }
 
 TEST(RobustScale, MedianNearTakesTheUpperMiddleOfAnEvenCount) {
