@@ -15,10 +15,14 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
   }
   if (!(units_per_metre > 0.0)) throw std::invalid_argument("depth scale must be positive");
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
   cv::Mat metres(depth.size(), CV_32FC1);
-  auto keep = [&](float d) {
-    return std::isfinite(d) && d > 0.0f && d >= min_depth && d <= max_depth;
-  };
+  // The range as the floats that bound it (the least float >= min_depth, the greatest <=
+  // max_depth): comparing in float keeps exactly the same depths and lets the loops vectorise.
+  float lo = static_cast<float>(min_depth), hi = static_cast<float>(max_depth);
+  if (lo < min_depth) lo = std::nextafter(lo, inf);
+  if (hi > max_depth) hi = std::nextafter(hi, -inf);
+  auto keep = [&](float d) { return d > 0.0f && d < inf && d >= lo && d <= hi; };
   if (depth.depth() == CV_16U) {
     const float scale = static_cast<float>(1.0 / units_per_metre);
     for (int v = 0; v < depth.rows; ++v) {

@@ -145,6 +145,35 @@ TEST(RgbdFrontend, InvalidDepthIsSkipped) {
   EXPECT_EQ(cloud.firstNonFinite(), -1);
 }
 
+// The range is the closed interval of the given doubles, also for the floats next to its ends
+// (0.7 and 2.3 round below and above themselves as floats; 0.1 above).
+TEST(RgbdFrontend, DepthRangeKeepsExactlyTheFloatsWithinIt) {
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const auto& [min_depth, max_depth] :
+       std::vector<std::pair<double, double>>{{0.7, 2.3}, {0.1, 0.3}, {0.0, 4.0}}) {
+    std::vector<float> values;
+    for (const double end : {min_depth, max_depth}) {
+      const float f = static_cast<float>(end);
+      for (const float v : {std::nextafter(f, -inf), f, std::nextafter(f, inf)})
+        values.push_back(v);
+    }
+    values.insert(values.end(), {0.0f, -1.0f, inf, std::numeric_limits<float>::quiet_NaN()});
+    const cv::Mat depth(1, static_cast<int>(values.size()), CV_32FC1, values.data());
+    const cv::Mat metres = cvo::depthToMetres(depth, 1.0, min_depth, max_depth);
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const double d = values[k];
+      const bool kept = std::isfinite(d) && d > 0.0 && d >= min_depth && d <= max_depth;
+      const float out = metres.at<float>(0, static_cast<int>(k));
+      if (kept) {
+        EXPECT_EQ(out, values[k]) << values[k] << " in [" << min_depth << ", " << max_depth << "]";
+      } else {
+        EXPECT_TRUE(std::isnan(out))
+            << values[k] << " in [" << min_depth << ", " << max_depth << "] kept";
+      }
+    }
+  }
+}
+
 TEST(RgbdFrontend, DistortionModelMovesRaysOffCentre) {
   const std::vector<cv::Point> pixels{{318, 255}, {20, 20}};
   const auto distorted = cvo::normalisedRays(pixels, cvo::tumIntrinsics("fr1"));
