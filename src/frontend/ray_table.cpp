@@ -1,5 +1,8 @@
 #include "cvo_odometry/frontend/ray_table.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 namespace cvo {
@@ -7,24 +10,26 @@ namespace cvo {
 std::vector<cv::Point2f> RayTable::rays(const std::vector<cv::Point>& pixels,
                                         const PinholeIntrinsics& intrinsics) {
   if (intrinsics.distortion.empty()) return normalisedRays(pixels, intrinsics);
+  const auto width = static_cast<std::size_t>(intrinsics.width);
   if (table_.empty() || !(intrinsics == intrinsics_)) {
-    std::vector<cv::Point> every;
-    every.reserve(static_cast<std::size_t>(intrinsics.width) *
-                  static_cast<std::size_t>(intrinsics.height));
-    for (int y = 0; y < intrinsics.height; ++y) {
-      for (int x = 0; x < intrinsics.width; ++x)
-        every.emplace_back(x, y);
-    }
-    table_.clear();  // a throw below leaves no table to read
-    table_ = normalisedRays(every, intrinsics);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    table_.assign(width * static_cast<std::size_t>(intrinsics.height), cv::Point2f(nan, nan));
     intrinsics_ = intrinsics;
   }
-  std::vector<cv::Point2f> out(pixels.size());
-  for (std::size_t k = 0; k < pixels.size(); ++k) {
-    const cv::Point& p = pixels[k];
-    out[k] = table_[static_cast<std::size_t>(p.y) * static_cast<std::size_t>(intrinsics.width) +
-                    static_cast<std::size_t>(p.x)];
+  // Entries are filled as pixels are first asked for: no start-up cost for the whole image.
+  std::vector<cv::Point> missing;
+  for (const cv::Point& p : pixels) {
+    const std::size_t i = static_cast<std::size_t>(p.y) * width + static_cast<std::size_t>(p.x);
+    if (std::isnan(table_[i].x)) missing.push_back(p);
   }
+  const std::vector<cv::Point2f> found = normalisedRays(missing, intrinsics);
+  for (std::size_t k = 0; k < missing.size(); ++k)
+    table_[static_cast<std::size_t>(missing[k].y) * width +
+           static_cast<std::size_t>(missing[k].x)] = found[k];
+  std::vector<cv::Point2f> out(pixels.size());
+  for (std::size_t k = 0; k < pixels.size(); ++k)
+    out[k] = table_[static_cast<std::size_t>(pixels[k].y) * width +
+                    static_cast<std::size_t>(pixels[k].x)];
   return out;
 }
 

@@ -202,6 +202,11 @@ TEST(RgbdFrontend, RayTableGivesEachPixelsOwnUndistortedRay) {
   EXPECT_GT(std::abs(changed[0].x - looked_up[0].x), 1e-3);
   // No distortion: computed directly.
   EXPECT_EQ(table.rays(pixels, pinholeFr1()), cvo::normalisedRays(pixels, pinholeFr1()));
+  // Back to fr1: pixels asked before and new ones, each its own ray.
+  const std::vector<cv::Point> mixed{{639, 479}, {1, 2}, {0, 0}, {320, 240}, {1, 2}};
+  const auto again = table.rays(mixed, fr1);
+  for (std::size_t k = 0; k < mixed.size(); ++k)
+    EXPECT_EQ(again[k], cvo::normalisedRays({mixed[k]}, fr1)[0]) << "pixel " << mixed[k];
 }
 
 void expectError(const std::function<void()>& call, const std::string& words) {
