@@ -103,14 +103,15 @@ CVO_CPU_DISPATCH kernels::PointCurvature curvatureOfCandidates(
 }  // namespace
 
 void CpuBackend::Block::reserve(std::size_t n, bool with_appearance) {
-  if (n > x.size()) {
-    const std::size_t grown = std::max(n, 2 * x.size());
-    for (auto* v : {&x, &y, &z})
-      v->resize(grown);
-  }
-  if (with_appearance && n > appearance.size()) {
-    appearance.resize(x.size());
-    appearance_d2.resize(x.size());
+  // Each array on its own: one left short by a failed allocation must not pass for grown.
+  const auto grow = [n](std::vector<float>& v) {
+    if (v.size() < n) v.resize(std::max(n, 2 * v.size()));
+  };
+  for (auto* v : {&x, &y, &z})
+    grow(*v);
+  if (with_appearance) {
+    grow(appearance);
+    grow(appearance_d2);
   }
 }
 
@@ -206,13 +207,13 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
   });
 }
 
-void CpuBackend::Block::setExtent(const float* transformed, std::size_t count) {
+void CpuBackend::Block::setExtent(const float* transformed, std::size_t points) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < count; ++k)
+  for (std::size_t k = 0; k < points; ++k)
     sum += Eigen::Vector3d(transformed[3 * k], transformed[3 * k + 1], transformed[3 * k + 2]);
-  centre = count ? Eigen::Vector3d(sum / static_cast<double>(count)) : sum;
+  centre = points ? Eigen::Vector3d(sum / static_cast<double>(points)) : sum;
   spread = 0.0;
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t k = 0; k < points; ++k) {
     const Eigen::Vector3d z(transformed[3 * k], transformed[3 * k + 1], transformed[3 * k + 2]);
     spread = std::max(spread, (z - centre).norm());
   }

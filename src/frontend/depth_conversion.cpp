@@ -1,5 +1,6 @@
 #include "cvo_odometry/frontend/depth_conversion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -19,7 +20,10 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
   cv::Mat metres(depth.size(), CV_32FC1);
   // The range as the floats that bound it (the least float >= min_depth, the greatest <=
   // max_depth): comparing in float keeps exactly the same depths and lets the loops vectorise.
-  float lo = static_cast<float>(min_depth), hi = static_cast<float>(max_depth);
+  // (Clamped first: a double beyond float's range has no defined conversion.)
+  const double largest = std::numeric_limits<float>::max();
+  float lo = static_cast<float>(std::clamp(min_depth, -largest, largest));
+  float hi = static_cast<float>(std::clamp(max_depth, -largest, largest));
   if (lo < min_depth) lo = std::nextafter(lo, inf);
   if (hi > max_depth) hi = std::nextafter(hi, -inf);
   auto keep = [&](float d) { return d > 0.0f && d < inf && d >= lo && d <= hi; };

@@ -13,8 +13,9 @@ std::vector<cv::Point2f> RayTable::rays(const std::vector<cv::Point>& pixels,
   const auto width = static_cast<std::size_t>(intrinsics.width);
   if (table_.empty() || !(intrinsics == intrinsics_)) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    table_.assign(width * static_cast<std::size_t>(intrinsics.height), cv::Point2f(nan, nan));
+    table_.clear();  // a throw below leaves no table, never one sized for other intrinsics
     intrinsics_ = intrinsics;
+    table_.assign(width * static_cast<std::size_t>(intrinsics.height), cv::Point2f(nan, nan));
   }
   // Entries are filled as pixels are first asked for: no start-up cost for the whole image.
   std::vector<cv::Point> missing;

@@ -42,6 +42,20 @@ TEST(RobustScale, MedianNearIsExactWhenItsOwnSampleMisleadsIt) {
   EXPECT_EQ(cvo::medianNear(values, 0.0, scratch), median);
 }
 
+// Values exactly at the bracket's ends (guess 10: 9 and 11) count once, on the right side.
+TEST(RobustScale, MedianNearCountsTheBracketsEndsOnce) {
+  std::vector<double> scratch;
+  for (const std::vector<double>& values :
+       std::vector<std::vector<double>>{{9, 9, 9, 11, 11, 11, 10},
+                                        {1, 9, 9, 9, 12, 13, 14},
+                                        {8, 8, 8, 8, 9, 11, 11},
+                                        {9, 11},
+                                        {5, 9, 9, 11, 11, 11, 11, 20}}) {
+    std::vector<double> copy = values;
+    EXPECT_EQ(cvo::medianNear(copy, 10.0, scratch), plainMedian(values));
+  }
+}
+
 TEST(RobustScale, MedianNearTakesTheUpperMiddleOfAnEvenCount) {
   std::vector<double> values{4.0, 1.0, 3.0, 2.0}, scratch;
   EXPECT_EQ(cvo::medianNear(values, 3.0, scratch), 3.0);

@@ -3,6 +3,8 @@
 // base <- camera.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <opencv2/imgproc.hpp>
 
 #include "cvo_odometry/frontend/builtin_presets.hpp"
@@ -43,6 +45,23 @@ TEST(OdometryPipeline, AnyChangedByteChangesTheFingerprint) {
     cv::Mat changed = image.clone();
     changed.ptr<unsigned char>(row)[byte] ^= 1;
     EXPECT_NE(cvo::imageFingerprint(changed), original) << "row " << row << ", byte " << byte;
+  }
+  // The top bit of a word, alone and in two words (FNV's multiply alone never carries a word's
+  // top byte down to the low bits, and two such flips cancelled).
+  std::mt19937 random(3);
+  for (int trial = 0; trial < 300; ++trial) {
+    cv::Mat changed = image.clone();
+    const int row = static_cast<int>(random() % static_cast<unsigned>(image.rows));
+    const std::size_t words = row_bytes / 8, word = random() % words;
+    if (trial % 2 == 0) {
+      changed.ptr<unsigned char>(row)[8 * word + 7] ^=
+          static_cast<unsigned char>(1 + random() % 255);
+    } else {  // bit 63 of two different words
+      changed.ptr<unsigned char>(row)[8 * word + 7] ^= 0x80;
+      changed.ptr<unsigned char>(row)[8 * ((word + 1 + random() % (words - 1)) % words) + 7] ^=
+          0x80;
+    }
+    ASSERT_NE(cvo::imageFingerprint(changed), original) << "trial " << trial;
   }
   // Two rows swapped: the same bytes elsewhere.
   cv::Mat swapped = image.clone();

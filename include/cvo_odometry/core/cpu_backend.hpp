@@ -47,8 +47,8 @@ class CpuBackend : public RegistrationBackend {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the points transformed by `pose`
     double spread = 0.0;                               // their largest distance from centre
 
-    // centre and spread of `count` transformed points (x, y, z interleaved).
-    void setExtent(const float* transformed, std::size_t count);
+    // centre and spread of `points` transformed points (x, y, z interleaved).
+    void setExtent(const float* transformed, std::size_t points);
 
     std::size_t size() const { return count; }
     void clear() { count = 0; }
