@@ -5,6 +5,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "cvo_odometry/core/lie_group.hpp"
+
 namespace cvo {
 
 Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
@@ -23,16 +25,11 @@ Eigen::Matrix<double, 6, 6> registrationCovariance(const LabeledCloud& source,
     sum += p;
     scatter.noalias() += p * p.transpose();
   }
-  const auto skew = [](const Eigen::Vector3d& v) {
-    Eigen::Matrix3d m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-  };
   Matrix6d information;
   information.topLeftCorner<3, 3>() =
       static_cast<double>(source.size()) * Eigen::Matrix3d::Identity();
-  information.topRightCorner<3, 3>() = -skew(sum);
-  information.bottomLeftCorner<3, 3>() = skew(sum);
+  information.topRightCorner<3, 3>() = -lie::hat(sum);
+  information.bottomLeftCorner<3, 3>() = lie::hat(sum);
   information.bottomRightCorner<3, 3>() = scatter.trace() * Eigen::Matrix3d::Identity() - scatter;
   information /= lengthscale * lengthscale;
   const Eigen::LDLT<Matrix6d> ldlt(information);

@@ -17,20 +17,20 @@ std::vector<cv::Point2f> RayTable::rays(const std::vector<cv::Point>& pixels,
     intrinsics_ = intrinsics;
     table_.assign(width * static_cast<std::size_t>(intrinsics.height), cv::Point2f(nan, nan));
   }
+  const auto slot = [width](const cv::Point& p) {
+    return static_cast<std::size_t>(p.y) * width + static_cast<std::size_t>(p.x);
+  };
   // Entries are filled as pixels are first asked for: no start-up cost for the whole image.
   std::vector<cv::Point> missing;
   for (const cv::Point& p : pixels) {
-    const std::size_t i = static_cast<std::size_t>(p.y) * width + static_cast<std::size_t>(p.x);
-    if (std::isnan(table_[i].x)) missing.push_back(p);
+    if (std::isnan(table_[slot(p)].x)) missing.push_back(p);
   }
   const std::vector<cv::Point2f> found = normalisedRays(missing, intrinsics);
   for (std::size_t k = 0; k < missing.size(); ++k)
-    table_[static_cast<std::size_t>(missing[k].y) * width +
-           static_cast<std::size_t>(missing[k].x)] = found[k];
+    table_[slot(missing[k])] = found[k];
   std::vector<cv::Point2f> out(pixels.size());
   for (std::size_t k = 0; k < pixels.size(); ++k)
-    out[k] = table_[static_cast<std::size_t>(pixels[k].y) * width +
-                    static_cast<std::size_t>(pixels[k].x)];
+    out[k] = table_[slot(pixels[k])];
   return out;
 }
 
