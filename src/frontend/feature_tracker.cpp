@@ -237,9 +237,13 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   prior.motion = current_from_previous.inverse();
   prior.focal_px = focal;
   // The inliers of the refined motion are the tracks that judge CVO.
+  prior.tracked_points.reserve(points.size());
+  prior.tracked_observations.reserve(points.size());
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
     const Eigen::Vector2d x(observed[k].x, observed[k].y);
+    prior.tracked_points.push_back(X);
+    prior.tracked_observations.push_back(x);
     const Eigen::Vector3d p = current_from_previous * X;
     if (!(p.z() > 1e-6) || (p.head<2>() / p.z() - x).norm() > threshold) continue;
     prior.points.push_back(X);

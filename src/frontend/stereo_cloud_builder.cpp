@@ -60,6 +60,11 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
                            options_.disparity_offset);
 }
 
+void StereoCloudBuilder::setDisparityOffset(double offset) {
+  if (!std::isfinite(offset)) throw std::invalid_argument("disparity offset must be finite");
+  options_.disparity_offset = offset;
+}
+
 LabeledCloud StereoCloudBuilder::build(const StereoFrame& frame, FrontendStats* stats,
                                        FrameImages* images) {
   const auto start = std::chrono::steady_clock::now();

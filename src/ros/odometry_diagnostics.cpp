@@ -29,6 +29,7 @@ void OdometryDiagnostics::count(const PipelineResult& result, double latency_ms)
     return;
   }
   ++frames_;
+  if (result.disparity_offset_estimate) disparity_offset_ = result.disparity_offset_estimate;
   const OdometryUpdate& update = result.update;
   switch (update.state) {
     case TrackingState::kRecovered:
@@ -92,6 +93,13 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("backend fallbacks", fallbacks_);
   status.add("resets", resets_);
   status.add("backend", backend_);
+  if (disparity_offset_) {
+    // Stereo self-calibration (README "Stereo scale"): what the front end uses once trusted.
+    status.add("disparity offset estimate (px)", disparity_offset_->offset);
+    status.add("disparity offset standard error (px)", disparity_offset_->standard_error);
+    status.add("disparity offset frame pairs", disparity_offset_->pairs);
+    status.add("disparity offset in use", disparity_offset_->trusted ? "yes" : "not yet");
+  }
   if (sync_.camera_info_stamp) {
     const std::optional<double> stamp = sync_.camera_info_stamp();
     char text[32] = "none yet";

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
@@ -104,6 +105,8 @@ int main(int argc, char** argv) {
     cvo::TrackingTally tally;
     DepthRange depths;
     std::vector<double> trusted;
+    std::optional<cvo::DisparityOffsetEstimate> offset_estimate;  // stereo self-calibration
+    std::optional<std::size_t> offset_trusted_from;
     for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
@@ -122,6 +125,13 @@ int main(int argc, char** argv) {
           timer.add("corners (beside)", result.prior->seed_ms);
         }
         if (result.cloud) depths.add(*result.cloud);
+        if (result.disparity_offset_ms > 0.0) {
+          timer.add("disparity offset", result.disparity_offset_ms);
+        }
+        if (result.disparity_offset_estimate) {
+          offset_estimate = result.disparity_offset_estimate;
+          if (offset_estimate->trusted && !offset_trusted_from) offset_trusted_from = k;
+        }
         timer.add("frontend", result.stats.time_ms);
         if (result.stats.matching_ms > 0.0) {
           timer.add("frontend: matching", result.stats.matching_ms);
@@ -167,6 +177,11 @@ int main(int argc, char** argv) {
             std::cerr << " with " << update.photometric.tracks << " tracks";
           }
         }
+        if (result.disparity_offset_estimate) {
+          std::cerr << ", disparity offset " << std::setprecision(3)
+                    << result.disparity_offset_estimate->offset << " px"
+                    << (result.disparity_offset_estimate->trusted ? "" : " (not yet used)");
+        }
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         if (!result.why.empty()) std::cerr << " [" << result.why << "]";
         std::cerr << "\n";
@@ -174,6 +189,17 @@ int main(int argc, char** argv) {
     }
     tally.print(std::cout);
     depths.print(std::cout);
+    if (offset_estimate) {
+      std::cout << std::fixed << std::setprecision(3) << "disparity offset: estimated "
+                << offset_estimate->offset << " px (standard error "
+                << offset_estimate->standard_error << " px, " << offset_estimate->pairs
+                << " frame pairs), ";
+      if (offset_trusted_from) {
+        std::cout << "used from frame " << *offset_trusted_from + 1 << " on\n";
+      } else {
+        std::cout << "never used: not trusted yet\n";
+      }
+    }
     timer.print(std::cout);
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))

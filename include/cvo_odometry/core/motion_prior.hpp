@@ -21,6 +21,11 @@ struct MotionPrior {
   // image sees them (normalised, undistorted image coordinates x/z, y/z).
   std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> points;
   std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>> observations;
+  // Every track that passed the forward-backward check, inlier or not, in the same form: a user
+  // that must not inherit the inlier test's bias (the disparity offset's estimate) judges them
+  // itself.
+  std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> tracked_points;
+  std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>> tracked_observations;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
   std::string problem;    // why no motion was solved
   double time_ms = 0.0;   // tracking and solving, on the caller's thread

@@ -20,6 +20,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cvo_odometry/core/disparity_offset_estimator.hpp"
 #include "cvo_odometry/core/keyframe_odometry.hpp"
 #include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/odometry_settings.hpp"
@@ -47,6 +48,11 @@ struct PipelineResult {
   // The feature prior's own odometry (start <- current, camera): its frame-to-frame motions
   // chained, constant velocity where it found none. A peer to compare with, never published.
   std::optional<Eigen::Isometry3d> prior_pose;
+  // Stereo: the disparity offset this frame's depth was built with (px), and the self-calibrated
+  // estimate so far (estimate_disparity_offset; README "Stereo scale").
+  double disparity_offset = 0.0;
+  std::optional<DisparityOffsetEstimate> disparity_offset_estimate;
+  double disparity_offset_ms = 0.0;  // the estimate's update, on the caller's thread
   double total_ms = 0.0;
 };
 
@@ -83,6 +89,9 @@ class OdometryPipeline {
                                                  FrameImages* images);
   // The prior's own pose for this frame.
   void advancePriorPose(PipelineResult& result);
+  // A stereo frame's tracks into the offset estimate; its trusted value for the next frames.
+  void calibrateDisparityOffset(const StereoFrame& frame, const FrameImages& images,
+                                PipelineResult& result);
   std::string staleness(const CameraFrame& frame);
 
   OdometrySettings settings_;
@@ -93,6 +102,10 @@ class OdometryPipeline {
   std::unique_ptr<StereoCloudBuilder> stereo_builder_;
   std::unique_ptr<FeatureTracker> tracker_;
   StaleFrameDetector stale_;
+  DisparityOffsetEstimator offset_estimator_;
+  double frame_offset_ = 0.0;     // the disparity offset the front end uses now
+  double previous_offset_ = 0.0;  // the one the last stereo frame was built with
+  cv::Mat previous_depth_;        // the last stereo frame's depth (metres)
   Eigen::Isometry3d prior_pose_ = Eigen::Isometry3d::Identity();  // of the last frame
   Eigen::Isometry3d prior_step_ = Eigen::Isometry3d::Identity();  // last frame to frame
   bool stale_burst_ = false;

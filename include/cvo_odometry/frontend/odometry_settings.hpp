@@ -20,6 +20,7 @@ struct OdometrySettings {
   FeatureTrackerOptions features;
   double depth_scale = 1000.0;    // 16-bit depth units per metre
   double disparity_offset = 0.0;  // px added to every stereo disparity (README "Stereo scale")
+  bool estimate_disparity_offset = true;  // self-calibrate it from the feature tracks
 
   // Throws std::invalid_argument naming the first setting that makes no sense.
   void validate() const;
@@ -66,6 +67,10 @@ void visitSettings(OdometrySettings& s, V&& v) {
                 "pixels added to every disparity before depth: a stereo calibration's correction",
                 -5.0, 5.0},
     s.disparity_offset);
+  v(SettingInfo{"estimate_disparity_offset", "stereo",
+                "estimate the disparity offset from the feature tracks and use it once trusted "
+                "(disparity_offset is the start)"},
+    s.estimate_disparity_offset);
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
   v(SettingInfo{"feature_prior", "features",

@@ -39,6 +39,8 @@ class StereoCloudBuilder {
   cv::Mat depth(const StereoFrame& frame) const;
 
   const StereoFrontendOptions& options() const { return options_; }
+  // From the next frame on (a self-calibrated value); throws std::invalid_argument if not finite.
+  void setDisparityOffset(double offset);
 
  private:
   StereoFrontendOptions options_;

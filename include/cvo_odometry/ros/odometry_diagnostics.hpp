@@ -54,6 +54,7 @@ class OdometryDiagnostics {
   bool lost_now_ = false;
   std::string lost_problem_, last_problem_, backend_;
   double latency_ms_ = 0.0, max_latency_ms_ = 0.0;
+  std::optional<DisparityOffsetEstimate> disparity_offset_;
   double min_rate_ = 1.0, max_rate_ = 100.0;
   diagnostic_updater::Updater updater_;
   std::unique_ptr<diagnostic_updater::HeaderlessTopicDiagnostic> rate_;
