@@ -492,8 +492,17 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     lost_frames_ = 0;
     return;
   }
-  // Keep the reference: the next frame is registered to the last good one.
   update.state = TrackingState::kLost;
+  if (previous_placed_by_prior_ && frame.cloud) {
+    // Placed by a confident prior: the next frame is registered to this one, one step away,
+    // rather than to a reference that falls further behind with every lost frame (at 3.6 m a
+    // step one lost KITTI frame used to lose the next ones on overlap, then restart). The last
+    // good frame stays the fallback.
+    setReference(frame.cloud, update.stamp);
+    update.new_keyframe = reference_ != nullptr;
+    return;
+  }
+  // Keep the reference: the next frame is registered to the last good one.
   update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
 }
 
