@@ -63,9 +63,10 @@ std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
       image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion), std::move(out));
 }
 
-std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
+std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point2f>& pixels,
                                         const PinholeIntrinsics& K) {
   std::vector<cv::Point2f> rays(pixels.size());
+  if (pixels.empty()) return rays;
   if (K.distortion.empty()) {
     for (std::size_t k = 0; k < pixels.size(); ++k) {
       rays[k] = cv::Point2f(static_cast<float>((pixels[k].x - K.cx) / K.fx),
@@ -73,11 +74,15 @@ std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
     }
     return rays;
   }
-  if (pixels.empty()) return rays;
-  std::vector<cv::Point2f> in(pixels.begin(), pixels.end());
   const cv::Matx33d camera(K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
-  cv::undistortPoints(in, rays, camera, K.distortion);
+  cv::undistortPoints(pixels, rays, camera, K.distortion);
   return rays;
+}
+
+std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
+                                        const PinholeIntrinsics& K) {
+  // Integer coordinates are exact in float: the same rays as the pixels' own.
+  return normalisedRays(std::vector<cv::Point2f>(pixels.begin(), pixels.end()), K);
 }
 
 DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)

@@ -11,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "cvo_odometry/frontend/depth_cloud_builder.hpp"
+
 namespace cvo {
 
 namespace {
@@ -21,22 +23,6 @@ constexpr std::size_t kMinTracks = 8;
 constexpr int kBackwardLevels = 1;
 // Rows above the crop that the corner measure reads.
 constexpr int kCornerContextRows = 2;
-
-std::vector<cv::Point2f> normalised(const std::vector<cv::Point2f>& pixels,
-                                    const PinholeIntrinsics& K) {
-  std::vector<cv::Point2f> out(pixels.size());
-  if (pixels.empty()) return out;
-  if (K.distortion.empty()) {
-    for (std::size_t k = 0; k < pixels.size(); ++k) {
-      out[k] = cv::Point2f(static_cast<float>((pixels[k].x - K.cx) / K.fx),
-                           static_cast<float>((pixels[k].y - K.cy) / K.fy));
-    }
-    return out;
-  }
-  const cv::Matx33d camera(K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
-  cv::undistortPoints(pixels, out, camera, K.distortion);
-  return out;
-}
 
 }  // namespace
 
@@ -116,7 +102,7 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
                           options_.min_distance, mask, 3, false);
   for (cv::Point2f& corner : corners)
     corner.y += static_cast<float>(first);
-  const std::vector<cv::Point2f> rays = normalised(corners, K);
+  const std::vector<cv::Point2f> rays = normalisedRays(corners, K);
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const float z = depth.at<float>(cvRound(corners[k].y), cvRound(corners[k].x));
     if (!std::isfinite(z) || !(z > 0.0f)) continue;
@@ -201,7 +187,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
     prior.problem = "only " + std::to_string(points.size()) + " corners tracked";
     return prior;
   }
-  const std::vector<cv::Point2f> observed = normalised(pixels, K);
+  const std::vector<cv::Point2f> observed = normalisedRays(pixels, K);
   const double focal = 0.5 * (K.fx + K.fy);
   const double threshold = options_.ransac_px / focal;
   cv::Mat rvec, tvec;

@@ -189,7 +189,7 @@ TEST(RgbdFrontend, RayTableGivesEachPixelsOwnUndistortedRay) {
   const auto looked_up = table.rays(pixels, fr1);
   ASSERT_EQ(looked_up.size(), pixels.size());
   for (std::size_t k = 0; k < pixels.size(); ++k) {
-    const auto alone = cvo::normalisedRays({pixels[k]}, fr1);
+    const auto alone = cvo::normalisedRays(std::vector<cv::Point>{pixels[k]}, fr1);
     EXPECT_EQ(looked_up[k], alone[0]) << "pixel " << pixels[k];  // bit for bit
   }
   // Other intrinsics: a new table, not the old one's rays.
@@ -206,7 +206,8 @@ TEST(RgbdFrontend, RayTableGivesEachPixelsOwnUndistortedRay) {
   const std::vector<cv::Point> mixed{{639, 479}, {1, 2}, {0, 0}, {320, 240}, {1, 2}};
   const auto again = table.rays(mixed, fr1);
   for (std::size_t k = 0; k < mixed.size(); ++k)
-    EXPECT_EQ(again[k], cvo::normalisedRays({mixed[k]}, fr1)[0]) << "pixel " << mixed[k];
+    EXPECT_EQ(again[k], cvo::normalisedRays(std::vector<cv::Point>{mixed[k]}, fr1)[0])
+        << "pixel " << mixed[k];
 }
 
 void expectError(const std::function<void()>& call, const std::string& words) {

@@ -50,7 +50,10 @@ std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
                                                      const PinholeIntrinsics& intrinsics,
                                                      int levels);
 
-// Rays (x/z, y/z) through pixel centres, undistorted when the intrinsics carry distortion.
+// Rays (x/z, y/z) through pixel centres (or sub-pixel positions), undistorted when the
+// intrinsics carry distortion.
+std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point2f>& pixels,
+                                        const PinholeIntrinsics& intrinsics);
 std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
                                         const PinholeIntrinsics& intrinsics);
 
