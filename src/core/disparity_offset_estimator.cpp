@@ -83,7 +83,8 @@ std::optional<DisparityOffsetEstimator::PairSolution> DisparityOffsetEstimator::
     const StereoTracks& tracks, const Eigen::Isometry3d& second_from_first, double focal_px,
     double focal_baseline, double current_offset) const {
   if (static_cast<int>(tracks.size()) < options_.min_tracks || !(focal_px > 0.0) ||
-      !(focal_baseline > 0.0)) {
+      !(focal_baseline > 0.0) || !std::isfinite(focal_px) || !std::isfinite(focal_baseline) ||
+      !std::isfinite(current_offset) || !second_from_first.matrix().allFinite()) {
     return std::nullopt;
   }
   // Two-view bundle adjustment: every track's point (first frame's camera) is free, observed
@@ -95,6 +96,13 @@ std::optional<DisparityOffsetEstimator::PairSolution> DisparityOffsetEstimator::
   Eigen::Isometry3d T = second_from_first;
   double offset = current_offset;
   std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> points;
+  // A track with a non-finite number says nothing; it must not poison the pair.
+  std::vector<char> finite(tracks.size(), 0);
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    const StereoTrack& t = tracks[i];
+    finite[i] = t.before.allFinite() && t.after.allFinite() && std::isfinite(t.disparity_before) &&
+                std::isfinite(t.disparity_after);
+  }
   std::vector<char> usable(tracks.size(), 0);
   points.reserve(tracks.size());
   for (const StereoTrack& track : tracks) {
@@ -116,7 +124,8 @@ std::optional<DisparityOffsetEstimator::PairSolution> DisparityOffsetEstimator::
     Vector7d b = Vector7d::Zero();
     int used = 0;
     for (std::size_t i = 0; i < tracks.size(); ++i) {
-      usable[i] = linearise(tracks[i], points[i], T, offset, focal_baseline, pixel, disp, &lin);
+      usable[i] = finite[i] &&
+                  linearise(tracks[i], points[i], T, offset, focal_baseline, pixel, disp, &lin);
       if (!usable[i]) continue;
       const double w = robustWeight(lin.residual.norm(), options_.huber_threshold,
                                     iteration >= kConvexIterations);
@@ -172,7 +181,7 @@ bool DisparityOffsetEstimator::addPair(const StereoTracks& tracks,
                                        double focal_baseline, double current_offset) {
   const std::optional<PairSolution> pair =
       solvePair(tracks, second_from_first, focal_px, focal_baseline, current_offset);
-  if (!pair) return false;
+  if (!pair || !std::isfinite(pair->offset) || !std::isfinite(pair->information)) return false;
   const double w = pair->information;
   sum_weight_ += w;
   sum_weight_squared_ += w * w;

@@ -78,6 +78,7 @@ void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   reference_covariance_.setZero();
   lost_frames_ = 0;
   started_ = false;
+  keyframe_requested_ = false;
   start_base_pose_ = base_pose;
 }
 
@@ -423,7 +424,7 @@ void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& c
 
 bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update) const {
   const CvoParams& p = params();
-  return p.reference == ReferenceKind::kPreviousFrame ||
+  return p.reference == ReferenceKind::kPreviousFrame || keyframe_requested_ ||
          update.state == TrackingState::kRecovered ||
          (reference_first_cosine_ &&
           update.cosine < p.keyframe_cosine_ratio * *reference_first_cosine_) ||
@@ -450,7 +451,10 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;
   last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_};
   update.new_keyframe = wantsKeyframe(update);
-  if (update.new_keyframe) setReference(frame.cloud, update.stamp);
+  if (update.new_keyframe) {
+    setReference(frame.cloud, update.stamp);
+    keyframe_requested_ = false;
+  }
   fillBaseFrame(update, motion_covariance);
   update.base_frame_motion =
       base_from_camera_ * previous.inverse() * pose_ * base_from_camera_.inverse();
@@ -493,7 +497,9 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     return;
   }
   update.state = TrackingState::kLost;
-  if (previous_placed_by_prior_ && frame.cloud) {
+  update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
+  if (previous_placed_by_prior_ && frame.cloud &&
+      frame.cloud->size() >= static_cast<std::size_t>(p.min_tracking_points)) {
     // Placed by a confident prior: the next frame is registered to this one, one step away,
     // rather than to a reference that falls further behind with every lost frame (at 3.6 m a
     // step one lost KITTI frame used to lose the next ones on overlap, then restart). The last
@@ -503,7 +509,6 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     return;
   }
   // Keep the reference: the next frame is registered to the last good one.
-  update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
 }
 
 void KeyframeOdometry::fillBaseFrame(OdometryUpdate& update, const Matrix6d& motion_covariance) {

@@ -24,29 +24,6 @@ std::string stampText(double stamp) {
   return out.str();
 }
 
-// The disparity (f b / depth) at pixel (u, v) when its 3x3 neighbourhood is one surface, its
-// disparities within kMaxDisparitySpread of each other; NaN otherwise. A corner on an occluding
-// edge has the background's disparity on one side and the foreground's on the other: the matcher
-// may give either, and the track follows a mixture of the two as they move apart.
-constexpr double kMaxDisparitySpread = 1.0;  // px
-double smoothDisparity(const cv::Mat& depth, double x, double y, double focal_baseline) {
-  const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
-  if (u < 1 || v < 1 || u + 1 >= depth.cols || v + 1 >= depth.rows) return NAN;
-  double low = INFINITY, high = -INFINITY;
-  for (int dv = -1; dv <= 1; ++dv) {
-    const float* row = depth.ptr<float>(v + dv);
-    for (int du = -1; du <= 1; ++du) {
-      const float z = row[u + du];
-      if (!(z > 0.0f) || !std::isfinite(z)) return NAN;
-      const double disparity = focal_baseline / z;
-      low = std::min(low, disparity);
-      high = std::max(high, disparity);
-    }
-  }
-  if (high - low > kMaxDisparitySpread) return NAN;
-  return focal_baseline / depth.at<float>(v, u);
-}
-
 }  // namespace
 
 OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFactory factory)
@@ -56,7 +33,7 @@ OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFact
   rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(settings_.rgbdOptions());
   stereo_builder_ = std::make_unique<StereoCloudBuilder>(settings_.stereoOptions());
   tracker_ = std::make_unique<FeatureTracker>(settings_.features);
-  frame_offset_ = previous_offset_ = settings_.disparity_offset;
+  offset_calibration_ = makeOffsetCalibration(settings_);
 }
 
 std::unique_ptr<KeyframeOdometry> OdometryPipeline::makeOdometry(const OdometrySettings& settings) {
@@ -77,20 +54,22 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   auto tracker = std::make_unique<FeatureTracker>(settings.features);
   const bool new_backend = settings.cvo.backend != settings_.cvo.backend ||
                            settings.cvo.num_threads != settings_.cvo.num_threads;
-  // The offset's estimate belongs to the rig: it survives other changes, not a new start value.
-  const bool new_offset = settings.disparity_offset != settings_.disparity_offset ||
-                          settings.estimate_disparity_offset != settings_.estimate_disparity_offset;
-  if (!new_offset) stereo->setDisparityOffset(frame_offset_);
+  // The offset's estimate belongs to the rig: it survives other changes, not new settings of
+  // its own.
+  const DisparityOffsetOptions& a = settings.disparity_offset_estimate;
+  const DisparityOffsetOptions& b = settings_.disparity_offset_estimate;
+  const bool new_offset =
+      settings.disparity_offset != settings_.disparity_offset ||
+      settings.estimate_disparity_offset != settings_.estimate_disparity_offset ||
+      a.min_pairs != b.min_pairs || a.max_standard_error != b.max_standard_error;
+  auto offset_calibration = new_offset ? makeOffsetCalibration(settings) : nullptr;
   std::unique_ptr<KeyframeOdometry> odometry;
   if (new_backend) odometry = makeOdometry(settings);
   settings_ = settings;
   rgbd_builder_ = std::move(rgbd);
   stereo_builder_ = std::move(stereo);
   tracker_ = std::move(tracker);  // the next frame only takes its corners
-  if (new_offset) {
-    offset_estimator_.reset();
-    frame_offset_ = previous_offset_ = settings.disparity_offset;
-  }
+  if (offset_calibration) offset_calibration_ = std::move(offset_calibration);
   if (new_backend) {
     odometry_ = std::move(odometry);
     reset(start_pose_);
@@ -118,55 +97,22 @@ std::string OdometryPipeline::staleness(const CameraFrame& frame) {
                       {"left", "right", "disparity"});
 }
 
+std::unique_ptr<DisparityOffsetCalibration> OdometryPipeline::makeOffsetCalibration(
+    const OdometrySettings& settings) {
+  return std::make_unique<DisparityOffsetCalibration>(settings.disparity_offset,
+                                                      settings.estimate_disparity_offset,
+                                                      settings.disparity_offset_estimate);
+}
+
 std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,
                                                                  FrontendStats* stats,
                                                                  FrameImages* images) {
   if (const auto* rgbd = std::get_if<RgbdFrame>(&frame)) {
     return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats, images));
   }
-  return std::make_shared<const LabeledCloud>(
-      stereo_builder_->build(std::get<StereoFrame>(frame), stats, images));
-}
-
-void OdometryPipeline::calibrateDisparityOffset(const StereoFrame& frame, const FrameImages& images,
-                                                PipelineResult& result) {
-  const double previous_offset = previous_offset_;
-  previous_offset_ = frame_offset_;
-  if (!settings_.estimate_disparity_offset) return;
-  const std::optional<MotionPrior>& prior = result.prior;
-  const cv::Mat& depth = images.depth;
-  if (prior && prior->solved && result.update.trusted() && !result.update.firstFrame() &&
-      depth.type() == CV_32FC1 && previous_depth_.size() == depth.size() &&
-      previous_depth_.type() == CV_32FC1) {
-    // The prior's tracks, their raw disparities at both ends (depth back to disparity, less the
-    // offset each frame was built with). All of them, not PnP's inliers: those agree with the
-    // depth at the offset in use, which would pull the estimate towards it (KITTI 06 at stride 3:
-    // 0.07 px from inliers against 0.22 at stride 1).
-    const PinholeIntrinsics& K = frame.intrinsics;
-    const double focal_baseline = K.fx * frame.baseline;
-    StereoTracks tracks;
-    tracks.reserve(prior->tracked_points.size());
-    for (std::size_t k = 0; k < prior->tracked_points.size(); ++k) {
-      const Eigen::Vector3d& point = prior->tracked_points[k];
-      const Eigen::Vector2d& seen = prior->tracked_observations[k];
-      if (!(point.z() > 0.0)) continue;
-      const Eigen::Vector2d before = point.head<2>() / point.z();
-      const double after_disparity =
-          smoothDisparity(depth, seen.x() * K.fx + K.cx, seen.y() * K.fy + K.cy, focal_baseline);
-      const double before_disparity = smoothDisparity(previous_depth_, before.x() * K.fx + K.cx,
-                                                      before.y() * K.fy + K.cy, focal_baseline);
-      if (std::isnan(after_disparity) || std::isnan(before_disparity)) continue;
-      tracks.push_back(
-          {before, seen, before_disparity - previous_offset, after_disparity - frame_offset_});
-    }
-    offset_estimator_.addPair(tracks, prior->motion.inverse(), K.fx, focal_baseline, frame_offset_);
-  }
-  previous_depth_ = depth;
-  result.disparity_offset_estimate = offset_estimator_.estimate();
-  if (result.disparity_offset_estimate && result.disparity_offset_estimate->trusted) {
-    frame_offset_ = result.disparity_offset_estimate->offset;
-    stereo_builder_->setDisparityOffset(frame_offset_);
-  }
+  const auto& stereo = std::get<StereoFrame>(frame);
+  stereo_builder_->setDisparityOffset(offset_calibration_->offsetFor(stereo));
+  return std::make_shared<const LabeledCloud>(stereo_builder_->build(stereo, stats, images));
 }
 
 void OdometryPipeline::advancePriorPose(PipelineResult& result) {
@@ -228,6 +174,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
         tracker_->track(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
     if (tracked) input.prior = result.prior = std::move(prior);
   }
+  const auto* stereo = std::get_if<StereoFrame>(&frame);
+  if (stereo) offset_calibration_->frameTracked(images.depth);
   result.cloud = input.cloud;
   result.reference = odometry_->referenceCloud();
   try {
@@ -238,10 +186,15 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     return result;
   }
   advancePriorPose(result);
-  if (const auto* stereo = std::get_if<StereoFrame>(&frame)) {
-    result.disparity_offset = frame_offset_;
+  if (stereo) {
+    result.disparity_offset = offset_calibration_->offset();
     const auto calibration_start = std::chrono::steady_clock::now();
-    calibrateDisparityOffset(*stereo, images, result);
+    if (offset_calibration_->update(*stereo, images.depth, result.prior,
+                                    result.update.trusted() && !result.update.firstFrame())) {
+      // The next clouds differ from the keyframe's: the next good frame becomes the keyframe.
+      odometry_->requestKeyframe();
+    }
+    result.disparity_offset_estimate = offset_calibration_->estimate();
     result.disparity_offset_ms = millisecondsSince(calibration_start);
   }
   result.total_ms = millisecondsSince(start);

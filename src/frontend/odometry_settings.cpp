@@ -1,5 +1,8 @@
 #include "cvo_odometry/frontend/odometry_settings.hpp"
 
+#include <cmath>
+#include <stdexcept>
+
 namespace cvo {
 
 void OdometrySettings::validate() const {
@@ -8,6 +11,10 @@ void OdometrySettings::validate() const {
   stereo.validate();
   features.validate();
   if (!(depth_scale > 0.0)) throw std::invalid_argument("depth_scale must be positive");
+  if (!std::isfinite(disparity_offset)) {
+    throw std::invalid_argument("disparity_offset must be finite");
+  }
+  DisparityOffsetEstimator check(disparity_offset_estimate);  // throws on options out of range
 }
 
 CloudBuilderOptions OdometrySettings::cloudOptions() const {

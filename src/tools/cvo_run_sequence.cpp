@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
     DepthRange depths;
     std::vector<double> trusted;
     std::optional<cvo::DisparityOffsetEstimate> offset_estimate;  // stereo self-calibration
-    std::optional<std::size_t> offset_trusted_from;
+    std::optional<std::size_t> offset_changed_at;  // the first frame built with another offset
+    double offset_in_use = settings.disparity_offset;
     for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
@@ -130,7 +131,10 @@ int main(int argc, char** argv) {
         }
         if (result.disparity_offset_estimate) {
           offset_estimate = result.disparity_offset_estimate;
-          if (offset_estimate->trusted && !offset_trusted_from) offset_trusted_from = k;
+          if (!offset_changed_at && result.disparity_offset != settings.disparity_offset) {
+            offset_changed_at = k;
+          }
+          offset_in_use = result.disparity_offset;
         }
         timer.add("frontend", result.stats.time_ms);
         if (result.stats.matching_ms > 0.0) {
@@ -178,9 +182,9 @@ int main(int argc, char** argv) {
           }
         }
         if (result.disparity_offset_estimate) {
-          std::cerr << ", disparity offset " << std::setprecision(3)
-                    << result.disparity_offset_estimate->offset << " px"
-                    << (result.disparity_offset_estimate->trusted ? "" : " (not yet used)");
+          std::cerr << ", disparity offset " << std::setprecision(3) << result.disparity_offset
+                    << " px (estimate " << result.disparity_offset_estimate->offset
+                    << (result.disparity_offset_estimate->trusted ? ")" : ", not trusted yet)");
         }
         if (!update.problem.empty()) std::cerr << " (" << update.problem << ")";
         if (!result.why.empty()) std::cerr << " [" << result.why << "]";
@@ -194,10 +198,13 @@ int main(int argc, char** argv) {
                 << offset_estimate->offset << " px (standard error "
                 << offset_estimate->standard_error << " px, " << offset_estimate->pairs
                 << " frame pairs), ";
-      if (offset_trusted_from) {
-        std::cout << "used from frame " << *offset_trusted_from + 1 << " on\n";
+      if (offset_changed_at) {
+        std::cout << "in use " << offset_in_use << " px, from frame " << *offset_changed_at
+                  << " on\n";
       } else {
-        std::cout << "never used: not trusted yet\n";
+        std::cout << "in use: the start, " << offset_in_use << " px ("
+                  << (offset_estimate->trusted ? "within the step of it" : "not trusted yet")
+                  << ")\n";
       }
     }
     timer.print(std::cout);

@@ -275,11 +275,14 @@ class ShiftedSourceBackend : public cvo::RegistrationBackend {
 // prior, and becomes the next frame's reference: one step away, instead of a last good frame that
 // falls further behind with each lost frame (at KITTI stride 3 one lost frame used to lose the
 // next five on overlap, then restart: README "Large motions").
-TEST(FastMotion, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
+class LostFramePolicies : public testing::TestWithParam<cvo::LostFramePolicy> {};
+
+TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
   const Fixture fixture = kitti();
   cvo::OdometrySettings settings;
   cvo::applyPreset(fixture.preset, &settings);
   settings.cvo.backend = cvo::BackendChoice::kCpu;
+  settings.cvo.lost_frame_policy = GetParam();
   auto wrong = std::make_shared<bool>(false);
   cvo::OdometryPipeline pipeline(
       settings, [wrong](const cvo::CvoParams& p) -> std::unique_ptr<cvo::RegistrationBackend> {
@@ -292,10 +295,12 @@ TEST(FastMotion, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
   for (std::size_t k = 0; k < fixture.stamps.size(); ++k) {
     *wrong = k == kLostFrame;
     const cvo::PipelineResult r = pipeline.process(fixture.stamps[k], fixture.frame(k));
-    out.estimate.append(fixture.stamps[k], r.update.pose);
+    if (r.update.has_pose) out.estimate.append(fixture.stamps[k], r.update.pose);
     if (r.update.trusted()) out.trusted.push_back(fixture.stamps[k]);
     if (k == kLostFrame) {
       EXPECT_EQ(r.update.state, cvo::TrackingState::kLost) << r.update.problem;
+      // It is lost all the same: the policy says whether its (the prior's) pose is published.
+      EXPECT_EQ(r.update.has_pose, GetParam() == cvo::LostFramePolicy::kKeepGuess);
       ASSERT_TRUE(r.prior && r.prior->solved);
       EXPECT_TRUE(r.update.new_keyframe);
       lost_cloud = r.cloud;
@@ -311,5 +316,9 @@ TEST(FastMotion, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
   // The whole trajectory, the prior's placement of the lost frame included, stays close.
   EXPECT_LT(report.ate.rmse, 0.1);
 }
+
+INSTANTIATE_TEST_SUITE_P(Policies, LostFramePolicies,
+                         testing::Values(cvo::LostFramePolicy::kKeepGuess,
+                                         cvo::LostFramePolicy::kPublishNothing));
 
 }  // namespace

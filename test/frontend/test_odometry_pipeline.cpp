@@ -169,12 +169,17 @@ TEST(OdometryPipeline, BaseFrameOutputsFollowTheCameraMount) {
 
 namespace {
 
-// The bundled KITTI 06 frames through the pipeline; the last frame's offset estimate.
-std::optional<cvo::DisparityOffsetEstimate> kittiOffsetEstimate(double start_offset,
-                                                                double* last_used = nullptr) {
+cvo::OdometrySettings kittiSettings() {
   cvo::OdometrySettings settings;
   cvo::applyPreset("kitti_stereo", &settings);
   settings.cvo.backend = cvo::BackendChoice::kCpu;
+  return settings;
+}
+
+// The bundled KITTI 06 frames through the pipeline; the last frame's offset estimate.
+std::optional<cvo::DisparityOffsetEstimate> kittiOffsetEstimate(double start_offset,
+                                                                double* last_used = nullptr) {
+  cvo::OdometrySettings settings = kittiSettings();
   settings.disparity_offset = start_offset;
   cvo::OdometryPipeline pipeline(settings);
   const cvo::KittiSequence sequence(std::string(CVO_TEST_DATA_DIR) + "/kitti_06_stereo", 0, "");
@@ -206,4 +211,71 @@ TEST(OdometryPipeline, EstimatesTheRigsDisparityOffsetFromItsTracks) {
   const auto from_one = kittiOffsetEstimate(1.0);
   ASSERT_TRUE(from_one.has_value());
   EXPECT_NEAR(from_one->offset, from_zero->offset, 0.05);
+}
+
+// With the estimate trusted after two pairs, the front end takes it: each frame is built with the
+// offset the previous frames' estimate settled on, the frame after a change is a keyframe (its
+// clouds differ from the old keyframe's), other settings keep it, its own settings and a new
+// camera start again.
+TEST(OdometryPipeline, UsesATrustedDisparityOffsetAndKeepsItsBookkeeping) {
+  cvo::OdometrySettings settings = kittiSettings();
+  settings.cvo.reference = cvo::ReferenceKind::kKeyframe;
+  // Keyframes only where asked for (or after a recovery): the offset's change must ask.
+  settings.cvo.keyframe_max_translation = 1000.0;
+  settings.cvo.keyframe_max_rotation = 180.0;
+  settings.cvo.keyframe_cosine_ratio = 0.0;
+  settings.disparity_offset_estimate.min_pairs = 2;
+  settings.disparity_offset_estimate.max_standard_error = 1.0;
+  cvo::OdometryPipeline pipeline(settings);
+  const cvo::KittiSequence sequence(std::string(CVO_TEST_DATA_DIR) + "/kitti_06_stereo", 0, "");
+  double used = 0.0;
+  bool changed = false;
+  std::size_t changes = 0;
+  for (std::size_t k = 0; k < sequence.stamps().size(); ++k) {
+    const cvo::PipelineResult result =
+        pipeline.process(sequence.stamps()[k], cvo_test::kittiFrame(sequence, k));
+    ASSERT_EQ(result.outcome, cvo::FrameOutcome::kProcessed) << result.why;
+    EXPECT_TRUE(result.update.trusted()) << "frame " << k;
+    if (changed) {
+      EXPECT_NE(result.disparity_offset, used) << "frame " << k;
+      EXPECT_TRUE(result.update.new_keyframe) << "frame " << k << ": the first at a new offset";
+      EXPECT_EQ(result.update.state, cvo::TrackingState::kTracking) << "frame " << k;
+      ++changes;
+    } else {
+      EXPECT_EQ(result.disparity_offset, used) << "frame " << k;
+    }
+    used = result.disparity_offset;
+    ASSERT_TRUE(k == 0 || result.disparity_offset_estimate.has_value());
+    changed = result.disparity_offset_estimate && result.disparity_offset_estimate->trusted &&
+              std::abs(result.disparity_offset_estimate->offset - used) >=
+                  cvo::DisparityOffsetCalibration::kOffsetStep;
+    if (changed) used = result.disparity_offset;  // what this frame was built with
+  }
+  ASSERT_GE(changes, 1u);
+  EXPECT_GT(used, 0.1);
+  EXPECT_LT(used, 0.6);
+  const std::size_t last = sequence.stamps().size() - 1;
+  const double stamp = sequence.stamps()[last] + 0.1;
+  // Another setting: the offset stays.
+  cvo::OdometrySettings other = settings;
+  other.cvo.max_iterations += 1;
+  pipeline.setSettings(other);
+  // (Earlier frames again, so that none is a stale repeat of the one before.)
+  cvo::PipelineResult next = pipeline.process(stamp, cvo_test::kittiFrame(sequence, last - 1));
+  ASSERT_EQ(next.outcome, cvo::FrameOutcome::kProcessed) << next.why;
+  EXPECT_EQ(next.disparity_offset, used);
+  // A new camera (another baseline): back to the start, the estimate begun anew.
+  cvo::StereoFrame wider = cvo_test::kittiFrame(sequence, last);
+  wider.baseline *= 1.5;
+  next = pipeline.process(stamp + 0.1, wider);
+  ASSERT_EQ(next.outcome, cvo::FrameOutcome::kProcessed) << next.why;
+  EXPECT_EQ(next.disparity_offset, settings.disparity_offset);
+  EXPECT_FALSE(next.disparity_offset_estimate.has_value());
+  // The offset's own settings: start again from the new value.
+  cvo::OdometrySettings restarted = other;
+  restarted.disparity_offset = 0.7;
+  pipeline.setSettings(restarted);
+  next = pipeline.process(stamp + 0.2, cvo_test::kittiFrame(sequence, last - 2));
+  ASSERT_EQ(next.outcome, cvo::FrameOutcome::kProcessed) << next.why;
+  EXPECT_EQ(next.disparity_offset, 0.7);
 }

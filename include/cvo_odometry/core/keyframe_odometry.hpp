@@ -104,6 +104,9 @@ class KeyframeOdometry {
 
   // New parameters from the next frame on (see CvoRegistration::setParams).
   void setParams(const CvoParams& params);
+  // The next frame registered well becomes the keyframe, whatever the thresholds say: its cloud
+  // is built differently from the keyframe's (a new stereo disparity offset).
+  void requestKeyframe() { keyframe_requested_ = true; }
 
   CvoRegistration& registration() { return registration_; }
   const CvoParams& params() const { return registration_.params(); }
@@ -180,6 +183,7 @@ class KeyframeOdometry {
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;
   bool previous_placed_by_prior_ = false;  // the last lost frame's pose came from the prior
+  bool keyframe_requested_ = false;
   bool started_ = false;
   Eigen::Isometry3d base_from_camera_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d start_base_pose_ = Eigen::Isometry3d::Identity();

@@ -20,8 +20,8 @@
 
 #include <Eigen/Geometry>
 
-#include "cvo_odometry/core/disparity_offset_estimator.hpp"
 #include "cvo_odometry/core/keyframe_odometry.hpp"
+#include "cvo_odometry/frontend/disparity_offset_calibration.hpp"
 #include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/odometry_settings.hpp"
 #include "cvo_odometry/frontend/stale_frame_detector.hpp"
@@ -83,15 +83,14 @@ class OdometryPipeline {
 
  private:
   std::unique_ptr<KeyframeOdometry> makeOdometry(const OdometrySettings& settings);
+  static std::unique_ptr<DisparityOffsetCalibration> makeOffsetCalibration(
+      const OdometrySettings& settings);
   // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
   // throws std::invalid_argument.
   std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
                                                  FrameImages* images);
   // The prior's own pose for this frame.
   void advancePriorPose(PipelineResult& result);
-  // A stereo frame's tracks into the offset estimate; its trusted value for the next frames.
-  void calibrateDisparityOffset(const StereoFrame& frame, const FrameImages& images,
-                                PipelineResult& result);
   std::string staleness(const CameraFrame& frame);
 
   OdometrySettings settings_;
@@ -102,12 +101,9 @@ class OdometryPipeline {
   std::unique_ptr<StereoCloudBuilder> stereo_builder_;
   std::unique_ptr<FeatureTracker> tracker_;
   StaleFrameDetector stale_;
-  DisparityOffsetEstimator offset_estimator_;
-  double frame_offset_ = 0.0;     // the disparity offset the front end uses now
-  double previous_offset_ = 0.0;  // the one the last stereo frame was built with
-  cv::Mat previous_depth_;        // the last stereo frame's depth (metres)
-  Eigen::Isometry3d prior_pose_ = Eigen::Isometry3d::Identity();  // of the last frame
-  Eigen::Isometry3d prior_step_ = Eigen::Isometry3d::Identity();  // last frame to frame
+  std::unique_ptr<DisparityOffsetCalibration> offset_calibration_;  // stereo
+  Eigen::Isometry3d prior_pose_ = Eigen::Isometry3d::Identity();    // of the last frame
+  Eigen::Isometry3d prior_step_ = Eigen::Isometry3d::Identity();    // last frame to frame
   bool stale_burst_ = false;
   Eigen::Isometry3d start_pose_ = Eigen::Isometry3d::Identity();
 };

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cvo_odometry/core/cvo_settings.hpp"
+#include "cvo_odometry/core/disparity_offset_estimator.hpp"
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 #include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
@@ -21,6 +22,7 @@ struct OdometrySettings {
   double depth_scale = 1000.0;    // 16-bit depth units per metre
   double disparity_offset = 0.0;  // px added to every stereo disparity (README "Stereo scale")
   bool estimate_disparity_offset = true;  // self-calibrate it from the feature tracks
+  DisparityOffsetOptions disparity_offset_estimate;
 
   // Throws std::invalid_argument naming the first setting that makes no sense.
   void validate() const;
@@ -71,6 +73,13 @@ void visitSettings(OdometrySettings& s, V&& v) {
                 "estimate the disparity offset from the feature tracks and use it once trusted "
                 "(disparity_offset is the start)"},
     s.estimate_disparity_offset);
+  v(SettingInfo{"disparity_offset_min_pairs", "stereo",
+                "frame pairs before the estimated disparity offset is used", 2, 100000},
+    s.disparity_offset_estimate.min_pairs);
+  v(SettingInfo{"disparity_offset_max_error", "stereo",
+                "the estimated disparity offset is used once its standard error is below this (px)",
+                0.001, 10.0},
+    s.disparity_offset_estimate.max_standard_error);
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
   v(SettingInfo{"feature_prior", "features",
