@@ -78,13 +78,25 @@ void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   reference_covariance_.setZero();
   lost_frames_ = 0;
   started_ = false;
-  keyframe_requested_ = false;
   start_base_pose_ = base_pose;
 }
 
 void KeyframeOdometry::setParams(const CvoParams& params) {
   registration_.setParams(params);
   reference_self_.reset();  // the kernels may have changed
+}
+
+void KeyframeOdometry::remapDepths(const std::function<float(float)>& new_depth) {
+  const auto remapped = [&](const std::shared_ptr<const LabeledCloud>& cloud) {
+    return std::make_shared<const LabeledCloud>(cloud->withDepths(new_depth));
+  };
+  const std::shared_ptr<const LabeledCloud> before = reference_;
+  if (reference_) reference_ = remapped(reference_);
+  if (last_good_ && last_good_->cloud) {
+    last_good_->cloud = last_good_->cloud == before ? reference_ : remapped(last_good_->cloud);
+  }
+  reference_self_.reset();
+  source_self_.reset();
 }
 
 void KeyframeOdometry::checkStamp(double stamp) const {
@@ -424,7 +436,7 @@ void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& c
 
 bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update) const {
   const CvoParams& p = params();
-  return p.reference == ReferenceKind::kPreviousFrame || keyframe_requested_ ||
+  return p.reference == ReferenceKind::kPreviousFrame ||
          update.state == TrackingState::kRecovered ||
          (reference_first_cosine_ &&
           update.cosine < p.keyframe_cosine_ratio * *reference_first_cosine_) ||
@@ -453,7 +465,6 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   update.new_keyframe = wantsKeyframe(update);
   if (update.new_keyframe) {
     setReference(frame.cloud, update.stamp);
-    keyframe_requested_ = false;
   }
   fillBaseFrame(update, motion_covariance);
   update.base_frame_motion =

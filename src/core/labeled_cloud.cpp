@@ -41,6 +41,20 @@ LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
   return out;
 }
 
+LabeledCloud LabeledCloud::withDepths(const std::function<float(float)>& new_depth) const {
+  LabeledCloud out(has_color_, semantic_classes_);
+  out.reserve(size());
+  for (std::size_t i = 0; i < size(); ++i) {
+    const float depth = position(i).z();
+    const float moved = new_depth(depth);
+    if (!(depth > 0.0f) || !(moved > 0.0f) || !std::isfinite(moved)) continue;
+    out.add(position(i) * (moved / depth), has_color_ ? color(i) : nullptr,
+            semantic_classes_ ? semantics(i) : nullptr);
+  }
+  out.image_ = image_;  // each point stays on its pixel's ray
+  return out;
+}
+
 LabeledCloud LabeledCloud::picked(std::size_t count,
                                   const std::function<std::size_t(std::size_t)>& index) const {
   LabeledCloud out(has_color_, semantic_classes_);

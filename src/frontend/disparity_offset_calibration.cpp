@@ -97,8 +97,17 @@ bool DisparityOffsetCalibration::update(const StereoFrame& frame, const cv::Mat&
       std::abs(estimate->offset - offset_) < kOffsetStep) {
     return false;
   }
+  changed_by_ = estimate->offset - offset_;
+  focal_baseline_ = frame.intrinsics.fx * frame.baseline;
   offset_ = estimate->offset;
   return true;
+}
+
+std::function<float(float)> DisparityOffsetCalibration::depthChange() const {
+  return [change = changed_by_, focal_baseline = focal_baseline_](float depth) {
+    const double disparity = focal_baseline / depth + change;
+    return disparity > 0.0 ? static_cast<float>(focal_baseline / disparity) : NAN;
+  };
 }
 
 }  // namespace cvo

@@ -71,6 +71,20 @@ bool FeatureTracker::seeded() {
   return !points_.empty();
 }
 
+void FeatureTracker::remapDepths(const std::function<float(float)>& new_depth) {
+  finishSeeding();
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < points_.size(); ++k) {
+    const float depth = points_[k].z;
+    const float moved = new_depth(depth);
+    if (!(depth > 0.0f) || !(moved > 0.0f) || !std::isfinite(moved)) continue;
+    points_[kept] = points_[k] * (moved / depth);
+    pixels_[kept++] = pixels_[k];
+  }
+  points_.resize(kept);
+  pixels_.resize(kept);
+}
+
 void FeatureTracker::reset() {
   finishSeeding();
   forgetCorners();

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
@@ -191,8 +192,11 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     const auto calibration_start = std::chrono::steady_clock::now();
     if (offset_calibration_->update(*stereo, images.depth, result.prior,
                                     result.update.trusted() && !result.update.firstFrame())) {
-      // The next clouds differ from the keyframe's: the next good frame becomes the keyframe.
-      odometry_->requestKeyframe();
+      // The next clouds are built at the new offset: what is kept of earlier frames (the
+      // reference, the last good frame, the corners to track) is moved to it.
+      const std::function<float(float)> new_depth = offset_calibration_->depthChange();
+      odometry_->remapDepths(new_depth);
+      tracker_->remapDepths(new_depth);
     }
     result.disparity_offset_estimate = offset_calibration_->estimate();
     result.disparity_offset_ms = millisecondsSince(calibration_start);

@@ -2,8 +2,11 @@
 // (test/data/tum_clouds, see test/data/README.md), with ground truth from groundtruth.txt.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
@@ -151,6 +154,38 @@ TEST(RealTum, ThinnedCloudSpreadsItsPointsEvenly) {
     ASSERT_EQ(thinned.position(k), cloud.position(k * cloud.size() / 1000)) << k;
   }
   EXPECT_EQ(cloud.thinned(cloud.size() + 5).size(), cloud.size());
+}
+
+// A new depth for every point (a stereo rig's disparity offset changed): each point stays on its
+// ray (the same pixel), its features and the image kept; points left without a depth dropped.
+TEST(RealTum, CloudWithNewDepthsKeepsEachPointOnItsRay) {
+  auto cloud = cvo::readCloud(kData + "/tum_clouds/frame10_3000.cloud");
+  cloud.setImage(std::make_shared<const cvo::IntensityImage>(
+      3, 3, cvo::CameraModel{},
+      std::vector<cvo::IntensityImage::Level>{{0.0, std::vector<float>(9)}}));
+  const float far = 1.5f;  // beyond it, no depth
+  const auto moved =
+      cloud.withDepths([&](float z) { return z < far ? 2.0f * z + 0.1f : std::nanf(""); });
+  EXPECT_EQ(moved.image(), cloud.image());
+  ASSERT_EQ(moved.hasColor(), cloud.hasColor());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f p = cloud.position(i);
+    if (!(p.z() < far)) continue;
+    ASSERT_LT(k, moved.size());
+    const Eigen::Vector3f q = moved.position(k);
+    EXPECT_NEAR(q.z(), 2.0f * p.z() + 0.1f, 1e-5f) << i;
+    EXPECT_NEAR(q.x() / q.z(), p.x() / p.z(), 1e-6f) << i;
+    EXPECT_NEAR(q.y() / q.z(), p.y() / p.z(), 1e-6f) << i;
+    if (cloud.hasColor()) {
+      for (int c = 0; c < cvo::LabeledCloud::kColorDim; ++c)
+        ASSERT_EQ(moved.color(k)[c], cloud.color(i)[c]) << i;
+    }
+    ++k;
+  }
+  EXPECT_EQ(k, moved.size());
+  EXPECT_GT(k, 100u);
+  EXPECT_LT(k, cloud.size()) << "some points are beyond 1.5 m";
 }
 
 TEST(RealTum, IndicatorAtTheGuessIsTheSameWhereverItComesFrom) {

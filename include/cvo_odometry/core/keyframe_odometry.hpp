@@ -13,6 +13,7 @@
 // tracks agree with it.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -104,9 +105,11 @@ class KeyframeOdometry {
 
   // New parameters from the next frame on (see CvoRegistration::setParams).
   void setParams(const CvoParams& params);
-  // The next frame registered well becomes the keyframe, whatever the thresholds say: its cloud
-  // is built differently from the keyframe's (a new stereo disparity offset).
-  void requestKeyframe() { keyframe_requested_ = true; }
+  // The front end builds depths differently from now on (a new stereo disparity offset): the
+  // reference, and the last good frame kept for a fallback, are moved to what they would have
+  // been, each point along its ray to depth new_depth(z) (LabeledCloud::withDepths), so the next
+  // frame is registered to a reference built as it is.
+  void remapDepths(const std::function<float(float)>& new_depth);
 
   CvoRegistration& registration() { return registration_; }
   const CvoParams& params() const { return registration_.params(); }
@@ -183,7 +186,6 @@ class KeyframeOdometry {
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;
   bool previous_placed_by_prior_ = false;  // the last lost frame's pose came from the prior
-  bool keyframe_requested_ = false;
   bool started_ = false;
   Eigen::Isometry3d base_from_camera_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d start_base_pose_ = Eigen::Isometry3d::Identity();

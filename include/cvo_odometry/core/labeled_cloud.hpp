@@ -57,6 +57,10 @@ class LabeledCloud {
   // A copy with every position moved by `T` (features unchanged, no image: the image no longer
   // matches the positions).
   LabeledCloud transformed(const Eigen::Isometry3f& T) const;
+  // A copy with each point moved along its ray to the depth (z) `new_depth` gives its depth; the
+  // image is kept (every point stays on its pixel). Points given no positive finite depth, or
+  // without one, are dropped.
+  LabeledCloud withDepths(const std::function<float(float)>& new_depth) const;
   // Every `stride`-th point, starting with the first.
   LabeledCloud strided(std::size_t stride) const;
   // `count` points spread evenly over the cloud's order (point floor(k size / count), the first

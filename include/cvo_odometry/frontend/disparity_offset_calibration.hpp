@@ -4,14 +4,16 @@
 //
 // Bookkeeping it owns, frame by frame:
 //   - the offset in use starts at the setting `disparity_offset` and moves to the estimate once
-//     it is trusted, then only by steps of at least kOffsetStep (each step builds clouds that
-//     differ from the keyframe's: the caller is told, to take a new keyframe);
+//     it is trusted, then only by steps of at least kOffsetStep; each step changes the depths
+//     the front end builds, and the caller moves what it keeps of earlier frames to the new
+//     offset (depthChange) so that the next frame meets a reference built as it is;
 //   - the previous frame's depth and offset, which the next frame's tracks start from: recorded
 //     as soon as the tracker has taken a frame, whatever the registration then says of it;
 //   - a change of camera (image size, focal length, baseline) starts the estimate anew: one
 //     rig's offset in pixels says nothing of another's.
 #pragma once
 
+#include <functional>
 #include <optional>
 
 #include <opencv2/core.hpp>
@@ -40,6 +42,10 @@ class DisparityOffsetCalibration {
   // trusted. Returns true when the offset in use changed (from the next frame on).
   bool update(const StereoFrame& frame, const cv::Mat& depth,
               const std::optional<MotionPrior>& prior, bool trusted);
+  // After update() returned true: a depth built with the offset before the change, as the new one
+  // builds it (z = f b / (d + offset), the same raw disparity d); NaN where the new offset leaves
+  // no positive disparity.
+  std::function<float(float)> depthChange() const;
 
   double offset() const { return offset_; }
   std::optional<DisparityOffsetEstimate> estimate() const { return estimator_.estimate(); }
@@ -63,6 +69,8 @@ class DisparityOffsetCalibration {
   double previous_offset_ = 0.0;  // and the offset it was built with
   cv::Mat current_depth_;         // this frame's, once tracked
   double current_offset_ = 0.0;
+  double changed_by_ = 0.0;      // the last change of the offset in use (px)
+  double focal_baseline_ = 0.0;  // of the camera it happened on
 };
 
 }  // namespace cvo

@@ -6,6 +6,7 @@
 // judges CVO's result by its inlier tracks (keyframe_odometry.hpp).
 #pragma once
 
+#include <functional>
 #include <future>
 #include <string>
 #include <vector>
@@ -44,6 +45,10 @@ class FeatureTracker {
   // The first frame after construction or reset() only seeds.
   MotionPrior track(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
                     int crop_top_rows = 0);
+  // The last frame's depths are built differently from now on (a new stereo disparity offset):
+  // its corners move along their rays to depth new_depth(z) (waits for them); those given no
+  // positive finite depth are dropped.
+  void remapDepths(const std::function<float(float)>& new_depth);
   // The last frame left corners to track (waits for them).
   bool seeded();
   // A frame was tracked since construction or reset(): the next prior relates two frames, solved
