@@ -108,9 +108,13 @@ TEST(DisparityOffsetEstimator, LargerMotionsGiveTheSameOffset) {
 TEST(DisparityOffsetEstimator, TrustedOnlyAfterEnoughAgreeingPairs) {
   cvo::DisparityOffsetEstimator estimator;
   EXPECT_FALSE(estimator.estimate().has_value());
-  runPairs(estimator, 5, 0.3, 0.0, TrackNoise{}, 3);
-  EXPECT_EQ(estimator.estimate()->pairs, 5);
+  const int min_pairs = cvo::DisparityOffsetOptions{}.min_pairs;
+  runPairs(estimator, min_pairs - 1, 0.3, 0.0, TrackNoise{}, 3);
+  EXPECT_EQ(estimator.estimate()->pairs, min_pairs - 1);
   EXPECT_FALSE(estimator.estimate()->trusted);  // fewer than min_pairs
+  runPairs(estimator, 1, 0.3, 0.0, TrackNoise{}, 4);
+  EXPECT_TRUE(estimator.estimate()->trusted);
+  EXPECT_NEAR(estimator.estimate()->offset, 0.3, 0.1);
   // Pairs that disagree wildly (each rig's offset different) are never trusted.
   cvo::DisparityOffsetEstimator scattered;
   for (int k = 0; k < 20; ++k) {

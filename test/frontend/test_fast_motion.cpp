@@ -307,7 +307,9 @@ TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
     } else if (k > 0) {
       EXPECT_EQ(r.update.state, cvo::TrackingState::kTracking) << "frame " << k;
     }
-    if (k == kLostFrame + 1) EXPECT_EQ(r.reference, lost_cloud);
+    if (k == kLostFrame + 1) {
+      EXPECT_EQ(r.reference, lost_cloud);
+    }
   }
   const auto report = evaluate(fixture, out);
   print("kitti, frame 3 lost", report);

@@ -315,7 +315,9 @@ TEST(OdometryPipeline, AJumpOfTheDisparityOffsetKeepsTracking) {
     EXPECT_TRUE(result.update.trusted()) << "frame " << k << ": " << result.update.problem;
     if (k > 0 && result.disparity_offset != used) {
       // The first change is the jump; later ones follow the estimate by a few hundredths.
-      if (++jumps == 1) EXPECT_GT(std::abs(result.disparity_offset - used), 1.0) << "frame " << k;
+      if (++jumps == 1) {
+        EXPECT_GT(std::abs(result.disparity_offset - used), 1.0) << "frame " << k;
+      }
       EXPECT_EQ(result.update.state, cvo::TrackingState::kTracking)
           << "frame " << k << ": " << result.update.problem;
       // The step's error against the ground truth, at the new offset (~1 m a frame).

@@ -33,7 +33,7 @@ using StereoTracks = std::vector<StereoTrack, Eigen::aligned_allocator<StereoTra
 
 struct DisparityOffsetOptions {
   int min_tracks = 30;              // fewer tracks in a pair: the pair is not used
-  int min_pairs = 10;               // pairs before an estimate is trusted
+  int min_pairs = 5;                // pairs before an estimate is trusted
   double max_standard_error = 0.1;  // px: the trusted estimate's spread over the pairs
   double max_pair_offset = 3.0;     // px: a pair's solution beyond this is not used
   double pixel_sigma = 1.0;         // px, a track's position error in the second image
