@@ -95,6 +95,10 @@ void KeyframeOdometry::remapDepths(const std::function<float(float)>& new_depth)
   if (last_good_ && last_good_->cloud) {
     last_good_->cloud = last_good_->cloud == before ? reference_ : remapped(last_good_->cloud);
   }
+  // Too few points left to register to: the next frame starts from its own (as setReference).
+  const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
+  if (reference_ && reference_->size() < minimum) reference_.reset();
+  if (last_good_ && last_good_->cloud && last_good_->cloud->size() < minimum) last_good_.reset();
   reference_self_.reset();
   source_self_.reset();
 }

@@ -36,6 +36,15 @@ double smoothDisparity(const cv::Mat& depth, double x, double y, double focal_ba
 
 }  // namespace
 
+std::function<float(float)> depthAtNewOffset(double from, double to, double focal_baseline,
+                                             double min_depth, double max_depth) {
+  return [change = to - from, focal_baseline, min_depth, max_depth](float depth) {
+    const double disparity = focal_baseline / depth + change;
+    const double moved = disparity > 0.0 ? focal_baseline / disparity : NAN;
+    return moved >= min_depth && moved <= max_depth ? static_cast<float>(moved) : NAN;
+  };
+}
+
 DisparityOffsetCalibration::DisparityOffsetCalibration(double start, bool enabled,
                                                        const DisparityOffsetOptions& options)
     : start_(start), enabled_(enabled), estimator_(options), offset_(start) {}
@@ -97,17 +106,21 @@ bool DisparityOffsetCalibration::update(const StereoFrame& frame, const cv::Mat&
       std::abs(estimate->offset - offset_) < kOffsetStep) {
     return false;
   }
-  changed_by_ = estimate->offset - offset_;
+  changed_from_ = offset_;
   focal_baseline_ = frame.intrinsics.fx * frame.baseline;
   offset_ = estimate->offset;
   return true;
 }
 
-std::function<float(float)> DisparityOffsetCalibration::depthChange() const {
-  return [change = changed_by_, focal_baseline = focal_baseline_](float depth) {
-    const double disparity = focal_baseline / depth + change;
-    return disparity > 0.0 ? static_cast<float>(focal_baseline / disparity) : NAN;
-  };
+std::function<float(float)> DisparityOffsetCalibration::depthChange(double min_depth,
+                                                                    double max_depth) const {
+  if (!(focal_baseline_ > 0.0)) return [](float depth) { return depth; };
+  return depthAtNewOffset(changed_from_, offset_, focal_baseline_, min_depth, max_depth);
+}
+
+std::optional<double> DisparityOffsetCalibration::focalBaseline() const {
+  if (!camera_) return std::nullopt;
+  return camera_->fx * camera_->baseline;
 }
 
 }  // namespace cvo

@@ -70,12 +70,22 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   rgbd_builder_ = std::move(rgbd);
   stereo_builder_ = std::move(stereo);
   tracker_ = std::move(tracker);  // the next frame only takes its corners
-  if (offset_calibration) offset_calibration_ = std::move(offset_calibration);
   if (new_backend) {
     odometry_ = std::move(odometry);
     reset(start_pose_);
   } else {
     odometry_->setParams(settings.cvo);
+  }
+  if (offset_calibration) {
+    // Back to the new start: the reference is moved there, as for an estimate's change.
+    const std::optional<double> focal_baseline = offset_calibration_->focalBaseline();
+    if (!new_backend && focal_baseline &&
+        offset_calibration->offset() != offset_calibration_->offset()) {
+      odometry_->remapDepths(depthAtNewOffset(offset_calibration_->offset(),
+                                              offset_calibration->offset(), *focal_baseline,
+                                              settings.cloud.min_depth, settings.cloud.max_depth));
+    }
+    offset_calibration_ = std::move(offset_calibration);
   }
   return new_backend;
 }
@@ -194,7 +204,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
                                     result.update.trusted() && !result.update.firstFrame())) {
       // The next clouds are built at the new offset: what is kept of earlier frames (the
       // reference, the last good frame, the corners to track) is moved to it.
-      const std::function<float(float)> new_depth = offset_calibration_->depthChange();
+      const std::function<float(float)> new_depth =
+          offset_calibration_->depthChange(settings_.cloud.min_depth, settings_.cloud.max_depth);
       odometry_->remapDepths(new_depth);
       tracker_->remapDepths(new_depth);
     }

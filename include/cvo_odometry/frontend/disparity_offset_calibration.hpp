@@ -24,10 +24,18 @@
 
 namespace cvo {
 
+// A depth built at disparity offset `from` (px) as offset `to` builds it, on a rig with
+// f b = `focal_baseline` (z = f b / (d + offset), the same raw disparity d); NaN where no positive
+// disparity is left or the new depth is outside [min_depth, max_depth], where the front end builds
+// none.
+std::function<float(float)> depthAtNewOffset(double from, double to, double focal_baseline,
+                                             double min_depth, double max_depth);
+
 class DisparityOffsetCalibration {
  public:
   // Smallest change of the offset in use (px): at 20 m (KITTI: 19 px of disparity) 0.05 px
-  // moves a point 5 cm; smaller changes wait, so that keyframes are not renewed every frame.
+  // moves a point 5 cm; smaller changes wait, so that what is kept of earlier frames is not
+  // moved to a new offset every frame.
   static constexpr double kOffsetStep = 0.05;
 
   // `start`: the setting disparity_offset; `enabled`: estimate_disparity_offset.
@@ -42,10 +50,11 @@ class DisparityOffsetCalibration {
   // trusted. Returns true when the offset in use changed (from the next frame on).
   bool update(const StereoFrame& frame, const cv::Mat& depth,
               const std::optional<MotionPrior>& prior, bool trusted);
-  // After update() returned true: a depth built with the offset before the change, as the new one
-  // builds it (z = f b / (d + offset), the same raw disparity d); NaN where the new offset leaves
-  // no positive disparity.
-  std::function<float(float)> depthChange() const;
+  // After update() returned true: a depth built with the offset before the change as the new one
+  // builds it (depthAtNewOffset); the identity before any change.
+  std::function<float(float)> depthChange(double min_depth, double max_depth) const;
+  // f b of the camera the estimate belongs to, once a frame has been seen.
+  std::optional<double> focalBaseline() const;
 
   double offset() const { return offset_; }
   std::optional<DisparityOffsetEstimate> estimate() const { return estimator_.estimate(); }
@@ -69,8 +78,8 @@ class DisparityOffsetCalibration {
   double previous_offset_ = 0.0;  // and the offset it was built with
   cv::Mat current_depth_;         // this frame's, once tracked
   double current_offset_ = 0.0;
-  double changed_by_ = 0.0;      // the last change of the offset in use (px)
-  double focal_baseline_ = 0.0;  // of the camera it happened on
+  double changed_from_ = 0.0;    // the offset in use before the last change
+  double focal_baseline_ = 0.0;  // of the camera it happened on; 0: no change yet
 };
 
 }  // namespace cvo
