@@ -81,9 +81,9 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
     const std::optional<double> focal_baseline = offset_calibration_->focalBaseline();
     if (!new_backend && focal_baseline &&
         offset_calibration->offset() != offset_calibration_->offset()) {
-      odometry_->remapDepths(depthAtNewOffset(offset_calibration_->offset(),
-                                              offset_calibration->offset(), *focal_baseline,
-                                              settings.cloud.min_depth, settings.cloud.max_depth));
+      moveKeptDepths(depthAtNewOffset(offset_calibration_->offset(), offset_calibration->offset(),
+                                      *focal_baseline, settings.cloud.min_depth,
+                                      settings.cloud.max_depth));
     }
     offset_calibration_ = std::move(offset_calibration);
   }
@@ -115,6 +115,11 @@ std::unique_ptr<DisparityOffsetCalibration> OdometryPipeline::makeOffsetCalibrat
                                                       settings.disparity_offset_estimate);
 }
 
+void OdometryPipeline::moveKeptDepths(const std::function<float(float)>& new_depth) {
+  odometry_->remapDepths(new_depth);
+  tracker_->remapDepths(new_depth);
+}
+
 std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,
                                                                  FrontendStats* stats,
                                                                  FrameImages* images) {
@@ -122,7 +127,15 @@ std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFra
     return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats, images));
   }
   const auto& stereo = std::get<StereoFrame>(frame);
-  stereo_builder_->setDisparityOffset(offset_calibration_->offsetFor(stereo));
+  // A new camera starts the offset again: the old rig's kept depths go to the start as well.
+  const double before = offset_calibration_->offset();
+  const std::optional<double> focal_baseline = offset_calibration_->focalBaseline();
+  const double offset = offset_calibration_->offsetFor(stereo);
+  if (offset != before && focal_baseline) {
+    moveKeptDepths(depthAtNewOffset(before, offset, *focal_baseline, settings_.cloud.min_depth,
+                                    settings_.cloud.max_depth));
+  }
+  stereo_builder_->setDisparityOffset(offset);
   return std::make_shared<const LabeledCloud>(stereo_builder_->build(stereo, stats, images));
 }
 
@@ -202,12 +215,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     const auto calibration_start = std::chrono::steady_clock::now();
     if (offset_calibration_->update(*stereo, images.depth, result.prior,
                                     result.update.trusted() && !result.update.firstFrame())) {
-      // The next clouds are built at the new offset: what is kept of earlier frames (the
-      // reference, the last good frame, the corners to track) is moved to it.
-      const std::function<float(float)> new_depth =
-          offset_calibration_->depthChange(settings_.cloud.min_depth, settings_.cloud.max_depth);
-      odometry_->remapDepths(new_depth);
-      tracker_->remapDepths(new_depth);
+      moveKeptDepths(
+          offset_calibration_->depthChange(settings_.cloud.min_depth, settings_.cloud.max_depth));
     }
     result.disparity_offset_estimate = offset_calibration_->estimate();
     result.disparity_offset_ms = millisecondsSince(calibration_start);

@@ -87,6 +87,9 @@ class OdometryPipeline {
       const OdometrySettings& settings);
   // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
   // throws std::invalid_argument.
+  // The stereo depths are built at another disparity offset from now on: what is kept of earlier
+  // frames (the reference, the last good frame, the corners to track) is moved to it.
+  void moveKeptDepths(const std::function<float(float)>& new_depth);
   std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
                                                  FrameImages* images);
   // The prior's own pose for this frame.
