@@ -16,9 +16,13 @@ rounds=${1:-5}
 data=${2:-$CVO_ROOT/test/data/tum_fr1_xyz}
 peer_build
 
+work=$(mktemp -d)
+# One run with $1 threads: "median/p95" of its total (the runner's log in $work on failure).
 run() {
-  "$runner" --tum "$data" --preset "$CVO_ROOT/config/tum_rgbd.yaml" --set backend=cpu --quiet \
-    "$@" | awk '/^  total/ {print $2 "/" $3}'
+  "$runner" --tum "$data" --preset "$CVO_ROOT/config/tum_rgbd.yaml" \
+    --set "backend=cpu,num_threads=$1" --quiet >"$work/out" 2>"$work/log" ||
+    { cat "$work/log" >&2; return 1; }
+  awk '/^  total/ {print $2 "/" $3}' "$work/out"
 }
 busy_loops=()
 stop_loops() {
@@ -26,17 +30,17 @@ stop_loops() {
   wait 2>/dev/null || true
   busy_loops=()
 }
-trap stop_loops EXIT
+trap 'stop_loops; rm -rf "$work"' EXIT
 
 declare -A medians
 for round in $(seq 1 "$rounds"); do
-  idle2=$(run) idle1=$(run --set num_threads=1)
+  idle2=$(run 2) idle1=$(run 1)
   for _ in 1 2; do
     bash -c 'while :; do :; done' &
     busy_loops+=($!)
   done
-  loaded2=$(run) loaded1=$(run --set num_threads=1)
-  loaded2b=$(run) loaded1b=$(run --set num_threads=1)
+  loaded2=$(run 2) loaded1=$(run 1)
+  loaded2b=$(run 2) loaded1b=$(run 1)
   stop_loops
   echo "round $round (median/p95 ms): idle 2 threads $idle2, 1 thread $idle1;" \
     "two busy loops: 2 threads $loaded2 $loaded2b, 1 thread $loaded1 $loaded1b"
