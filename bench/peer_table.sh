@@ -52,7 +52,7 @@ case "$kind" in
     # Every valid pixel: the grid's step is 1 px while (min + max) / 2 exceeds a quarter of them.
     full_cloud=(--point-selector grid --min-points 200000 --max-points 400000)
     methods=("ours (preset: geometric CVO + photometric rotation)|ours|"
-      "ours colour|ours|--set use_color=true"
+      "ours colour|ours|--use-color true"
       "OpenCV RgbdOdometry|opencv_rgbd|" "OpenCV ICPOdometry|opencv_icp|"
       "OpenCV RgbdICPOdometry|opencv_rgbdicp|"
       "PCL GICP (full cloud, 1 cm voxels)|pcl_gicp|${full_cloud[*]}"
@@ -67,7 +67,7 @@ case "$kind" in
     eval_opts=(--drift-lengths "10,20,30,40,50" --gt-times "$data/times.txt")
     preset="$CVO_ROOT/config/kitti_stereo.yaml"
     methods=("ours (preset: colour-intensity CVO)|ours|"
-      "ours geometric|ours|--set use_color=false"
+      "ours geometric|ours|--use-color false"
       "PCL GICP (our stereo clouds)|pcl_gicp|--preset $preset"
       "PCL NDT (our stereo clouds)|pcl_ndt|--preset $preset")
     ;;

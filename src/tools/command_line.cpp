@@ -11,6 +11,11 @@ CommandLine::CommandLine(int argc, char** argv, const std::set<std::string>& opt
     const std::string arg = argv[i];
     if (arg.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + arg + "'");
     const std::string name = arg.substr(2);
+    // A second value would silently replace the first (a second --set dropping the first's).
+    if (values_.count(name)) {
+      throw std::invalid_argument("option --" + name + " given twice" +
+                                  (name == "set" ? " (one --set takes k=v,k2=v2,...)" : ""));
+    }
     if (flags.count(name)) {
       values_[name] = "1";
     } else if (options.count(name)) {

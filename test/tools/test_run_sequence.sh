@@ -33,4 +33,9 @@ awk -v r="$r" 'BEGIN { exit !(r < 0.15) }' || fail "KITTI RPE $r deg, bound 0.15
 
 if "$runner" --tum "$tum" --kitti "$kitti" 2>"$work/err.txt"; then fail "two sequences accepted"; fi
 grep -q "give one sequence" "$work/err.txt" || fail "unclear error: $(cat "$work/err.txt")"
+# A repeated option is refused, not half dropped (a second --set once replaced the first).
+if "$runner" --tum "$tum" --set backend=cpu --set num_threads=1 2>"$work/err.txt"; then
+  fail "a repeated --set accepted"
+fi
+grep -q "given twice" "$work/err.txt" || fail "unclear error: $(cat "$work/err.txt")"
 echo "cvo_run_sequence: all checks passed"

@@ -10,8 +10,8 @@ namespace cvo {
 
 class CommandLine {
  public:
-  // `flags` take no value; every other option takes exactly one. Unknown options throw
-  // std::invalid_argument naming them.
+  // `flags` take no value; every other option takes exactly one. Unknown options, and an option
+  // given twice, throw std::invalid_argument naming them.
   CommandLine(int argc, char** argv, const std::set<std::string>& options,
               const std::set<std::string>& flags = {});
 
