@@ -16,8 +16,9 @@ while IFS='|' read -r label options; do
   out=$("$runner" --tum "$data" --preset "$root/config/tum_rgbd.yaml" --quiet \
     --gt "$data/groundtruth.txt" $options 2>&1) || { echo "failed: $label: $out" >&2; continue; }
   awk -v label="$(echo "$label" | xargs)" '
-    /^RPE frame-to-frame/ { t = $5 * 1000; r = $7 }
-    /^ATE rmse/ { a = $3 * 1000 }
+    # The first of each: ours (the feature prior alone is evaluated after it).
+    /^RPE frame-to-frame/ && t == "" { t = $5 * 1000; r = $7 }
+    /^ATE rmse/ && a == "" { a = $3 * 1000 }
     /^  registration/ { ms = $2 }
     END { printf "| %-58s | %9.2f | %9.3f | %8.2f | %8.1f |\n", label, t, r, a, ms }' <<<"$out"
 done < "$configs"
