@@ -41,14 +41,19 @@ LabeledCloud LabeledCloud::transformed(const Eigen::Isometry3f& T) const {
   return out;
 }
 
+float rayScale(float depth, const std::function<float(float)>& new_depth) {
+  if (!(depth > 0.0f) || !std::isfinite(depth)) return NAN;
+  const float moved = new_depth(depth);
+  return moved > 0.0f && std::isfinite(moved) ? moved / depth : NAN;
+}
+
 LabeledCloud LabeledCloud::withDepths(const std::function<float(float)>& new_depth) const {
   LabeledCloud out(has_color_, semantic_classes_);
   out.reserve(size());
   for (std::size_t i = 0; i < size(); ++i) {
-    const float depth = position(i).z();
-    const float moved = new_depth(depth);
-    if (!(depth > 0.0f) || !(moved > 0.0f) || !std::isfinite(moved)) continue;
-    out.add(position(i) * (moved / depth), has_color_ ? color(i) : nullptr,
+    const float scale = rayScale(position(i).z(), new_depth);
+    if (std::isnan(scale)) continue;
+    out.add(position(i) * scale, has_color_ ? color(i) : nullptr,
             semantic_classes_ ? semantics(i) : nullptr);
   }
   out.image_ = image_;  // each point stays on its pixel's ray

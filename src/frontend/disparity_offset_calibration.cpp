@@ -106,16 +106,8 @@ bool DisparityOffsetCalibration::update(const StereoFrame& frame, const cv::Mat&
       std::abs(estimate->offset - offset_) < kOffsetStep) {
     return false;
   }
-  changed_from_ = offset_;
-  focal_baseline_ = frame.intrinsics.fx * frame.baseline;
   offset_ = estimate->offset;
   return true;
-}
-
-std::function<float(float)> DisparityOffsetCalibration::depthChange(double min_depth,
-                                                                    double max_depth) const {
-  if (!(focal_baseline_ > 0.0)) return [](float depth) { return depth; };
-  return depthAtNewOffset(changed_from_, offset_, focal_baseline_, min_depth, max_depth);
 }
 
 std::optional<double> DisparityOffsetCalibration::focalBaseline() const {

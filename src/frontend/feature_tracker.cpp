@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "cvo_odometry/core/labeled_cloud.hpp"
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
 namespace cvo {
@@ -75,10 +76,9 @@ void FeatureTracker::remapDepths(const std::function<float(float)>& new_depth) {
   finishSeeding();
   std::size_t kept = 0;
   for (std::size_t k = 0; k < points_.size(); ++k) {
-    const float depth = points_[k].z;
-    const float moved = new_depth(depth);
-    if (!(depth > 0.0f) || !(moved > 0.0f) || !std::isfinite(moved)) continue;
-    points_[kept] = points_[k] * (moved / depth);
+    const float scale = rayScale(points_[k].z, new_depth);
+    if (std::isnan(scale)) continue;
+    points_[kept] = points_[k] * scale;
     pixels_[kept++] = pixels_[k];
   }
   points_.resize(kept);

@@ -77,14 +77,10 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
     odometry_->setParams(settings.cvo);
   }
   if (offset_calibration) {
-    // Back to the new start: the reference is moved there, as for an estimate's change.
-    const std::optional<double> focal_baseline = offset_calibration_->focalBaseline();
-    if (!new_backend && focal_baseline &&
-        offset_calibration->offset() != offset_calibration_->offset()) {
-      moveKeptDepths(depthAtNewOffset(offset_calibration_->offset(), offset_calibration->offset(),
-                                      *focal_baseline, settings.cloud.min_depth,
-                                      settings.cloud.max_depth));
-    }
+    // Back to the new start: the reference is moved there, as for an estimate's change (after
+    // a new backend's reset there is nothing to move).
+    moveKeptDepths(offset_calibration_->offset(), offset_calibration->offset(),
+                   offset_calibration_->focalBaseline());
     offset_calibration_ = std::move(offset_calibration);
   }
   return new_backend;
@@ -115,7 +111,11 @@ std::unique_ptr<DisparityOffsetCalibration> OdometryPipeline::makeOffsetCalibrat
                                                       settings.disparity_offset_estimate);
 }
 
-void OdometryPipeline::moveKeptDepths(const std::function<float(float)>& new_depth) {
+void OdometryPipeline::moveKeptDepths(double from, double to,
+                                      std::optional<double> focal_baseline) {
+  if (from == to || !focal_baseline) return;
+  const std::function<float(float)> new_depth = depthAtNewOffset(
+      from, to, *focal_baseline, settings_.cloud.min_depth, settings_.cloud.max_depth);
   odometry_->remapDepths(new_depth);
   tracker_->remapDepths(new_depth);
 }
@@ -131,10 +131,7 @@ std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFra
   const double before = offset_calibration_->offset();
   const std::optional<double> focal_baseline = offset_calibration_->focalBaseline();
   const double offset = offset_calibration_->offsetFor(stereo);
-  if (offset != before && focal_baseline) {
-    moveKeptDepths(depthAtNewOffset(before, offset, *focal_baseline, settings_.cloud.min_depth,
-                                    settings_.cloud.max_depth));
-  }
+  moveKeptDepths(before, offset, focal_baseline);
   stereo_builder_->setDisparityOffset(offset);
   return std::make_shared<const LabeledCloud>(stereo_builder_->build(stereo, stats, images));
 }
@@ -215,8 +212,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     const auto calibration_start = std::chrono::steady_clock::now();
     if (offset_calibration_->update(*stereo, images.depth, result.prior,
                                     result.update.trusted() && !result.update.firstFrame())) {
-      moveKeptDepths(
-          offset_calibration_->depthChange(settings_.cloud.min_depth, settings_.cloud.max_depth));
+      moveKeptDepths(result.disparity_offset, offset_calibration_->offset(),
+                     offset_calibration_->focalBaseline());
     }
     result.disparity_offset_estimate = offset_calibration_->estimate();
     result.disparity_offset_ms = millisecondsSince(calibration_start);

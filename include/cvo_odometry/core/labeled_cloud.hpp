@@ -18,6 +18,10 @@
 
 namespace cvo {
 
+// The factor that moves a point at depth (z) `depth` along its ray to depth new_depth(depth); NaN
+// when either depth is not positive and finite (the point is dropped).
+float rayScale(float depth, const std::function<float(float)>& new_depth);
+
 class LabeledCloud {
  public:
   static constexpr int kColorDim = kernels::kColorDim;

@@ -6,7 +6,7 @@
 //   - the offset in use starts at the setting `disparity_offset` and moves to the estimate once
 //     it is trusted, then only by steps of at least kOffsetStep; each step changes the depths
 //     the front end builds, and the caller moves what it keeps of earlier frames to the new
-//     offset (depthChange) so that the next frame meets a reference built as it is;
+//     offset (depthAtNewOffset) so that the next frame meets a reference built as it is;
 //   - the previous frame's depth and offset, which the next frame's tracks start from: recorded
 //     as soon as the tracker has taken a frame, whatever the registration then says of it;
 //   - a change of camera (image size, focal length, baseline) starts the estimate anew: one
@@ -50,9 +50,6 @@ class DisparityOffsetCalibration {
   // trusted. Returns true when the offset in use changed (from the next frame on).
   bool update(const StereoFrame& frame, const cv::Mat& depth,
               const std::optional<MotionPrior>& prior, bool trusted);
-  // After update() returned true: a depth built with the offset before the change as the new one
-  // builds it (depthAtNewOffset); the identity before any change.
-  std::function<float(float)> depthChange(double min_depth, double max_depth) const;
   // f b of the camera the estimate belongs to, once a frame has been seen.
   std::optional<double> focalBaseline() const;
 
@@ -78,8 +75,6 @@ class DisparityOffsetCalibration {
   double previous_offset_ = 0.0;  // and the offset it was built with
   cv::Mat current_depth_;         // this frame's, once tracked
   double current_offset_ = 0.0;
-  double changed_from_ = 0.0;    // the offset in use before the last change
-  double focal_baseline_ = 0.0;  // of the camera it happened on; 0: no change yet
 };
 
 }  // namespace cvo

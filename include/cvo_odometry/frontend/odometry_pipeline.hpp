@@ -85,11 +85,12 @@ class OdometryPipeline {
   std::unique_ptr<KeyframeOdometry> makeOdometry(const OdometrySettings& settings);
   static std::unique_ptr<DisparityOffsetCalibration> makeOffsetCalibration(
       const OdometrySettings& settings);
+  // The stereo depths are built at disparity offset `to` instead of `from` from now on (a rig
+  // with f b = `focal_baseline`, none known: nothing to move): what is kept of earlier frames
+  // (the reference, the last good frame, the corners to track) is moved to it.
+  void moveKeptDepths(double from, double to, std::optional<double> focal_baseline);
   // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
   // throws std::invalid_argument.
-  // The stereo depths are built at another disparity offset from now on: what is kept of earlier
-  // frames (the reference, the last good frame, the corners to track) is moved to it.
-  void moveKeptDepths(const std::function<float(float)>& new_depth);
   std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
                                                  FrameImages* images);
   // The prior's own pose for this frame.
