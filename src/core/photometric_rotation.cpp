@@ -144,7 +144,7 @@ PhotometricRotationResult refineRotationPhotometrically(
       if (!(points[j].z() > 0.0)) return;
       const Eigen::Vector2d p = current.camera().project(points[j]);
       if (!current.inside(p.x(), p.y())) return;
-      own[j] = current.sample(level, p.x(), p.y()).intensity;
+      own[j] = current.intensity(level, p.x(), p.y());
       if (!point_cluster.empty()) {
         point_cluster[j] = static_cast<std::size_t>(p.y() / kClusterCellPx) * cells_per_row +
                            static_cast<std::size_t>(p.x() / kClusterCellPx);

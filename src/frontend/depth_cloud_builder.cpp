@@ -42,22 +42,19 @@ void CloudBuilderOptions::validate() const {
 std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
                                                      const PinholeIntrinsics& K, int levels) {
   if (levels <= 0 || !CameraModel::supportsDistortion(K.distortion.size())) return nullptr;
-  cv::Mat grey;
-  toGrey(image).convertTo(grey, CV_32F, 1.0 / 255.0);
-  std::vector<IntensityImage::Level> out;
-  for (int l = 0; l < levels; ++l) {
-    IntensityImage::Level level;
-    level.blur_sigma = l + 1 < levels ? std::ldexp(1.0, levels - 2 - l) : 0.0;
-    cv::Mat blurred;  // a new buffer: blurring into a header of `grey` would blur it in place
-    if (level.blur_sigma > 0.0) {
-      cv::GaussianBlur(grey, blurred, cv::Size(), level.blur_sigma);
-    } else {
-      blurred = grey;
-    }
-    if (!blurred.isContinuous()) blurred = blurred.clone();
-    const float* values = blurred.ptr<float>();  // a plain copy: MatIterator is per element
-    level.values.assign(values, values + blurred.total());
-    out.push_back(std::move(level));
+  // Each level is written straight into its own buffer: no image is allocated and copied.
+  std::vector<IntensityImage::Level> out(static_cast<std::size_t>(levels));
+  const auto header = [&image](IntensityImage::Level& level) {
+    level.values.resize(image.total());
+    return cv::Mat(image.rows, image.cols, CV_32F, level.values.data());
+  };
+  cv::Mat sharp = header(out.back());  // the last level: unblurred
+  toGrey(image).convertTo(sharp, CV_32F, 1.0 / 255.0);
+  for (int l = 0; l + 1 < levels; ++l) {
+    IntensityImage::Level& level = out[static_cast<std::size_t>(l)];
+    level.blur_sigma = std::ldexp(1.0, levels - 2 - l);
+    cv::Mat blurred = header(level);
+    cv::GaussianBlur(sharp, blurred, cv::Size(), level.blur_sigma);
   }
   return std::make_shared<const IntensityImage>(
       image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion), std::move(out));

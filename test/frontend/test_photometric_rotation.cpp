@@ -122,6 +122,46 @@ TEST(IntensityImage, TheFrontEndAttachesBlurLevelsCoarseFirst) {
   EXPECT_FALSE(cvo::intensityImage(image, thin_prism, 2));  // no CameraModel for it
 }
 
+TEST(IntensityImage, SamplesTheCentralDifferencesOfEveryPixelUpToTheBorder) {
+  // Reference: gradient images stored whole (zero on the outermost rows and columns), sampled
+  // bilinearly; the image derives them per sample and must give the same numbers.
+  const int width = 7, height = 5;
+  cvo::IntensityImage::Level level;
+  for (int k = 0; k < width * height; ++k)
+    level.values.push_back(static_cast<float>(std::sin(0.7 * k) * 0.5 + 0.5));
+  const std::vector<float>& I = level.values;
+  std::vector<float> gu(I.size(), 0.0f), gv(I.size(), 0.0f);
+  for (int v = 1; v + 1 < height; ++v) {
+    for (int u = 1; u + 1 < width; ++u) {
+      const int i = v * width + u;
+      gu[i] = 0.5f * (I[i + 1] - I[i - 1]);
+      gv[i] = 0.5f * (I[i + width] - I[i - width]);
+    }
+  }
+  const cvo::IntensityImage image(width, height, cvo::CameraModel(5, 5, 3, 2, {}), {level});
+  const auto bilinear = [&](const std::vector<float>& m, double u, double v) {
+    const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+    const double a = u - u0, b = v - v0;
+    const int i = v0 * width + u0;
+    return (1.0 - b) * ((1.0 - a) * m[i] + a * m[i + 1]) +
+           b * ((1.0 - a) * m[i + width] + a * m[i + width + 1]);
+  };
+  int samples = 0;
+  for (double v = 1.0; v <= height - 2.0; v += 0.25) {
+    for (double u = 1.0; u <= width - 2.0; u += 0.25) {
+      ASSERT_TRUE(image.inside(u, v));
+      const cvo::IntensitySample s = image.sample(0, u, v);
+      EXPECT_EQ(s.intensity, bilinear(I, u, v)) << u << ", " << v;
+      EXPECT_EQ(image.intensity(0, u, v), s.intensity);
+      EXPECT_EQ(s.gradient_u, bilinear(gu, u, v)) << u << ", " << v;
+      EXPECT_EQ(s.gradient_v, bilinear(gv, u, v)) << u << ", " << v;
+      ++samples;
+    }
+  }
+  EXPECT_EQ(samples, 17 * 9);
+  EXPECT_FALSE(image.inside(width - 1.5, 1.0));
+}
+
 TEST(PhotometricRotation, CorrectsAWrongRotationTowardsTheGroundTruth) {
   // From 1 deg off, the solve creeps along the weak rotation/translation direction of image
   // alignment (the Jacobian leaves out the distortion), so it gets more iterations than the

@@ -1,7 +1,9 @@
 // A grey camera image for the photometric rotation stage: one or more levels of the same image
-// blurred by decreasing amounts (coarse first), each with its intensity gradients, and the camera
-// model that projects points into it. Built by the front end (which owns OpenCV); the core only
-// samples it.
+// blurred by decreasing amounts (coarse first), and the camera model that projects points into
+// it. Gradients are central differences taken where a sample needs them: stored gradient images
+// tripled the memory of every kept frame (11 MB at 640x480 with three levels), and touching that
+// much new memory made the first frames 2-3x slower than the rest. Built by the front end (which
+// owns OpenCV); the core only samples it.
 #pragma once
 
 #include <vector>
@@ -34,14 +36,16 @@ class IntensityImage {
   bool inside(double u, double v) const {
     return u >= 1.0 && v >= 1.0 && u <= width_ - 2.0 && v <= height_ - 2.0;
   }
-  // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v).
+  // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v). The
+  // gradient is zero on the image's outermost rows and columns.
   IntensitySample sample(int level, double u, double v) const;
+  // The bilinear intensity alone, as sample() gives it.
+  double intensity(int level, double u, double v) const;
 
  private:
   int width_, height_;
   CameraModel camera_;
   std::vector<Level> levels_;
-  std::vector<std::vector<float>> gradient_u_, gradient_v_;  // per level, central differences
 };
 
 }  // namespace cvo
