@@ -115,10 +115,15 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     semantics = std::make_unique<SemanticImage>(semantics_image, options_.semantic_classes,
                                                 options_.ignore_classes);
   }
-  cv::Mat valid = (depth == depth);  // false for NaN
+  cv::Mat valid;  // NaN is outside every range
+  cv::inRange(depth, options_.min_depth, options_.max_depth, valid);
   valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
-  if (valid_count == 0) throw EmptyFrameError("no pixel has valid depth");
+  if (valid_count == 0) {
+    if (cv::countNonZero(depth == depth) == 0) throw EmptyFrameError("no pixel has valid depth");
+    throw EmptyFrameError("no pixel has depth in [" + std::to_string(options_.min_depth) + ", " +
+                          std::to_string(options_.max_depth) + "] m");
+  }
   const cv::Mat grey = toGrey(image);
   FrontendStats local;
   const auto pixels = selector_.select(grey, valid, &local.selection);

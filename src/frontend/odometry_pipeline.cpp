@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -114,10 +115,12 @@ std::unique_ptr<DisparityOffsetCalibration> OdometryPipeline::makeOffsetCalibrat
 void OdometryPipeline::moveKeptDepths(double from, double to,
                                       std::optional<double> focal_baseline) {
   if (from == to || !focal_baseline) return;
-  const std::function<float(float)> new_depth = depthAtNewOffset(
-      from, to, *focal_baseline, settings_.cloud.min_depth, settings_.cloud.max_depth);
-  odometry_->remapDepths(new_depth);
-  tracker_->remapDepths(new_depth);
+  const double near = settings_.cloud.min_depth;
+  odometry_->remapDepths(
+      depthAtNewOffset(from, to, *focal_baseline, near, settings_.cloud.max_depth));
+  // The tracker's corners, like the depth image they come from, keep depths beyond max_depth.
+  tracker_->remapDepths(
+      depthAtNewOffset(from, to, *focal_baseline, near, std::numeric_limits<double>::infinity()));
 }
 
 std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,

@@ -1,6 +1,7 @@
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 #include "cvo_odometry/frontend/depth_conversion.hpp"
@@ -13,8 +14,10 @@ RgbdCloudBuilder::RgbdCloudBuilder(const RgbdFrontendOptions& options)
 LabeledCloud RgbdCloudBuilder::build(const RgbdFrame& frame, FrontendStats* stats,
                                      FrameImages* images) {
   const auto start = std::chrono::steady_clock::now();
-  const cv::Mat depth = depthToMetres(frame.depth, options_.depth_units_per_metre,
-                                      options_.cloud.min_depth, options_.cloud.max_depth);
+  // Beyond max_depth kept for the feature tracker; the cloud builder applies the range.
+  const cv::Mat depth =
+      depthToMetres(frame.depth, options_.depth_units_per_metre, options_.cloud.min_depth,
+                    std::numeric_limits<double>::infinity());
   LabeledCloud cloud =
       cloud_builder_.build(frame.image, depth, frame.intrinsics, frame.semantics, stats, images);
   if (stats) {

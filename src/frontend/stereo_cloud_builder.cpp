@@ -56,7 +56,7 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
     scale = 1.0;  // the matcher returns pixels
   }
   return disparityToMetres(disparity, frame.intrinsics.fx * frame.baseline, scale,
-                           options_.cloud.min_depth, options_.cloud.max_depth,
+                           options_.cloud.min_depth, std::numeric_limits<double>::infinity(),
                            options_.disparity_offset);
 }
 

@@ -11,6 +11,7 @@
 
 #include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/empty_frame_error.hpp"
 #include "cvo_odometry/frontend/ray_table.hpp"
 #include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
@@ -143,6 +144,33 @@ TEST(RgbdFrontend, InvalidDepthIsSkipped) {
   for (std::size_t i = 0; i < cloud.size(); ++i)
     ASSERT_GE(project(cloud.position(i), K).x, 319.5) << "point from a band of invalid depth";
   EXPECT_EQ(cloud.firstNonFinite(), -1);
+}
+
+// Depth beyond max_depth stays out of the cloud but in the depth image the feature tracker gets.
+TEST(RgbdFrontend, BeyondMaxDepthOnlyTheTrackerSees) {
+  const TumFrame f = loadFrame(5);
+  cvo::RgbdFrontendOptions o = options(cvo::SelectorKind::kGrid, 5000.0);
+  o.cloud.max_depth = 1.0;  // fr1_xyz's desk: 0.65-1.8 m
+  cvo::RgbdCloudBuilder builder(o);
+  cvo::FrameImages images;
+  const auto cloud = builder.build({f.image, f.depth, pinholeFr1(), cv::Mat()}, nullptr, &images);
+  ASSERT_GT(cloud.size(), 100u);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    ASSERT_LE(cloud.position(i).z(), 1.0f);
+  const int beyond = cv::countNonZero(images.depth > 1.0);
+  EXPECT_GT(beyond, 50000);
+  cv::Mat metres;
+  f.depth.convertTo(metres, CV_32F, 1.0 / 5000.0);
+  EXPECT_EQ(beyond, cv::countNonZero(metres > 1.0));
+  o.cloud.max_depth = 0.3;  // nearer than the desk
+  cvo::RgbdCloudBuilder empty(o);
+  try {
+    empty.build({f.image, f.depth, pinholeFr1(), cv::Mat()}, nullptr);
+    ADD_FAILURE() << "no depth in range must throw";
+  } catch (const cvo::EmptyFrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("no pixel has depth in [0.1"), std::string::npos)
+        << e.what();
+  }
 }
 
 // The range is the closed interval of the given doubles, also for the floats next to its ends

@@ -16,7 +16,11 @@
 namespace cvo {
 
 struct CloudBuilderOptions {
-  double min_depth = 0.1;  // metres; applied by whoever turns raw depth or disparity into metres
+  // The cloud's depth range (metres). Nearer depths are dropped when raw depth or disparity
+  // becomes metres; farther ones stay in the depth image, for the feature tracker (a far corner
+  // is tracked well through large motions, where near ones are lost), and only the cloud leaves
+  // them out.
+  double min_depth = 0.1;
   double max_depth = 10.0;
   int crop_top_rows = 0;  // rows at the top never selected (KITTI: sky and stereo-less band)
   SelectorOptions selector;
@@ -38,7 +42,8 @@ struct FrontendStats {
 };
 
 // What the front end made of a frame besides its cloud: the grey image and the metric depth
-// (CV_32FC1, NaN where invalid), for the feature tracker.
+// (CV_32FC1, NaN where invalid or nearer than min_depth, beyond max_depth kept), for the feature
+// tracker.
 struct FrameImages {
   cv::Mat grey;
   cv::Mat depth;
@@ -61,10 +66,11 @@ class DepthCloudBuilder {
  public:
   explicit DepthCloudBuilder(const CloudBuilderOptions& options);
 
-  // `depth_metres`: CV_32FC1, NaN where invalid, registered to `image` (8-bit BGR or grey).
+  // `depth_metres`: CV_32FC1, NaN where invalid, registered to `image` (8-bit BGR or grey); the
+  // cloud takes the pixels within [min_depth, max_depth].
   // Throws std::invalid_argument naming the problem: empty or mismatched images, intrinsics that
   // make no sense or do not match the image, a missing or unusable segmentation image; throws
-  // EmptyFrameError (a std::invalid_argument) when no pixel has valid depth or every selected
+  // EmptyFrameError (a std::invalid_argument) when no pixel has depth in range or every selected
   // one is in an ignored class.
   LabeledCloud build(const cv::Mat& image, const cv::Mat& depth_metres,
                      const PinholeIntrinsics& intrinsics, const cv::Mat& semantics,

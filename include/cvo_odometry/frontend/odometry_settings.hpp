@@ -46,7 +46,9 @@ void visitSettings(OdometrySettings& s, V&& v) {
     s.cloud.selector.max_points);
   v(SettingInfo{"min_depth", "depth", "nearer points are not used (m)", 0.0, 1000.0},
     s.cloud.min_depth);
-  v(SettingInfo{"max_depth", "depth", "farther points are not used (m)", 0.01, 10000.0},
+  v(SettingInfo{"max_depth", "depth",
+                "farther points stay out of the cloud; the feature prior still tracks them (m)",
+                0.01, 10000.0},
     s.cloud.max_depth);
   v(SettingInfo{"depth_scale", "depth", "16-bit depth units per metre (1000: ROS millimetres)",
                 1e-3, 1e6},

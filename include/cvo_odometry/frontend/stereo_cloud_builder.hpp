@@ -34,7 +34,8 @@ class StereoCloudBuilder {
   LabeledCloud build(const StereoFrame& frame, FrontendStats* stats = nullptr,
                      FrameImages* images = nullptr);
 
-  // Depth in metres (CV_32FC1, NaN invalid) of the frame, from its disparity or by matching;
+  // Depth in metres (CV_32FC1, NaN invalid or nearer than min_depth; beyond max_depth kept) of
+  // the frame, from its disparity or by matching;
   // matching leaves the rows above crop_top_rows NaN (never used) but for 16 rows of context.
   cv::Mat depth(const StereoFrame& frame) const;
 
