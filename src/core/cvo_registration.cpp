@@ -23,6 +23,12 @@ constexpr std::size_t kSelfProductPoints = 1000;
 // third (the poses within 0.01 mm), 12.0-13.2 with the first step's throughout. A failed step on
 // a reused Hessian sums a fresh one: 13.8 iterations a frame, 14.0 with a fresh one every step.
 constexpr int kNewtonStepsPerHessian = 3;
+// A Newton step is shortened to at most this many times the MM step's length (a trust region):
+// the full step went up to 10x, 4 deg on TUM fr1_xyz frame 33, F fell, Newton was switched off
+// and the MM steps walked back over 20 iterations, each departure rebuilding every candidate
+// list (6 times there). TUM at strides 1 / 3 / 5 / 8: 905 / 522 / 267 / 256 -> 812 / 491 / 184 /
+// 240 iterations in all (at 3x: 798 / 491 / 260 / 225), the poses within 0.02 mm.
+constexpr double kNewtonTrustRatio = 2.0;
 // Relative fall of the smoothed F below which it counts as unchanged.
 constexpr double kFallTolerance = 1e-8;
 // At ell_min, pairs crossing the retain threshold can make the steps hop round a cycle of nearby
@@ -202,11 +208,13 @@ void CvoRegistration::runProcrustes(const Eigen::Isometry3d& guess, double ell,
     // Near the optimum MM steps converge linearly, slowly along weakly constrained directions;
     // Newton's converge quadratically. Taken only while F rises, where the Hessian (the last
     // one summed) is negative definite and the step stays within 10x the MM step (a guard
-    // against a misleading model).
+    // against a misleading model), and shortened to the trust region.
     bool took_newton = false;
     if (with_curvature && !fell) {
       took_newton =
           newtonStep(curvature, ell, &newton) && newton.norm() < 10.0 * step.norm() + 1e-4;
+      const double trust = kNewtonTrustRatio * step.norm();
+      if (took_newton && newton.norm() > trust) newton *= trust / newton.norm();
       if (!took_newton) {
         // A fresh model without a maximum nearby will not have one an iteration later either:
         // stop paying for the curvature sums. A reused one is summed afresh first.
