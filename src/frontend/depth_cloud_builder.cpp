@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cvo_odometry/frontend/color_features.hpp"
+#include "cvo_odometry/frontend/depth_conversion.hpp"
 #include "cvo_odometry/frontend/empty_frame_error.hpp"
 #include "cvo_odometry/frontend/semantic_image.hpp"
 
@@ -116,7 +117,8 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
                                                 options_.ignore_classes);
   }
   cv::Mat valid;  // NaN is outside every range
-  cv::inRange(depth, options_.min_depth, options_.max_depth, valid);
+  const auto [lo, hi] = floatDepthRange(options_.min_depth, options_.max_depth);
+  cv::inRange(depth, lo, hi, valid);
   valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
   if (valid_count == 0) {

@@ -7,6 +7,17 @@
 
 namespace cvo {
 
+std::pair<float, float> floatDepthRange(double min_depth, double max_depth) {
+  // Clamped first: a double beyond float's range has no defined conversion.
+  const double largest = std::numeric_limits<float>::max();
+  const float inf = std::numeric_limits<float>::infinity();
+  float lo = static_cast<float>(std::clamp(min_depth, -largest, largest));
+  float hi = static_cast<float>(std::clamp(max_depth, -largest, largest));
+  if (lo < min_depth) lo = std::nextafter(lo, inf);
+  if (hi > max_depth) hi = std::nextafter(hi, -inf);
+  return {lo, hi};
+}
+
 cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_depth,
                       double max_depth) {
   if (depth.empty()) throw std::invalid_argument("depth image is empty");
@@ -18,14 +29,8 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
   cv::Mat metres(depth.size(), CV_32FC1);
-  // The range as the floats that bound it (the least float >= min_depth, the greatest <=
-  // max_depth): comparing in float keeps exactly the same depths and lets the loops vectorise.
-  // (Clamped first: a double beyond float's range has no defined conversion.)
-  const double largest = std::numeric_limits<float>::max();
-  float lo = static_cast<float>(std::clamp(min_depth, -largest, largest));
-  float hi = static_cast<float>(std::clamp(max_depth, -largest, largest));
-  if (lo < min_depth) lo = std::nextafter(lo, inf);
-  if (hi > max_depth) hi = std::nextafter(hi, -inf);
+  // Compared in float: the same depths, and the loops vectorise.
+  const auto [lo, hi] = floatDepthRange(min_depth, max_depth);
   auto keep = [&](float d) { return d > 0.0f && d < inf && d >= lo && d <= hi; };
   if (depth.depth() == CV_16U) {
     const float scale = static_cast<float>(1.0 / units_per_metre);
@@ -89,8 +94,7 @@ cv::Mat disparityToMetres(const cv::Mat& disparity, double focal_times_baseline,
   const auto scale = static_cast<float>(disparity_scale);
   const auto offset = static_cast<float>(disparity_offset);
   if (!std::isfinite(offset)) throw std::invalid_argument("disparity offset must be finite");
-  const auto lo = static_cast<float>(min_depth);
-  const auto hi = static_cast<float>(max_depth);
+  const auto [lo, hi] = floatDepthRange(min_depth, max_depth);
   switch (disparity.depth()) {
     case CV_32F:
       disparityRowsToMetres<float>(disparity, fb, scale, offset, lo, hi, &metres);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <utility>
+
 #include <opencv2/core.hpp>
 
 namespace cvo {
@@ -10,6 +12,10 @@ namespace cvo {
 // throw std::invalid_argument naming the type.
 cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_depth,
                       double max_depth);
+
+// The floats that bound [min_depth, max_depth] (the least float >= min_depth, the greatest <=
+// max_depth): comparing float depths with them keeps exactly the depths within the doubles.
+std::pair<float, float> floatDepthRange(double min_depth, double max_depth);
 
 }  // namespace cvo
 
