@@ -23,7 +23,8 @@ constexpr std::size_t kSelfProductPoints = 1000;
 // third (the poses within 0.01 mm), 12.0-13.2 with the first step's throughout. A failed step on
 // a reused Hessian sums a fresh one: 13.8 iterations a frame, 14.0 with a fresh one every step.
 constexpr int kNewtonStepsPerHessian = 3;
-// A Newton step is shortened to at most this many times the MM step's length (a trust region):
+// A Newton step is shortened to at most this many times the (unstretched) MM step's length (a
+// trust region):
 // the full step went up to 10x, 4 deg on TUM fr1_xyz frame 33, F fell, Newton was switched off
 // and the MM steps walked back over 20 iterations, each departure rebuilding every candidate
 // list (6 times there). TUM at strides 1 / 3 / 5 / 8: 905 / 522 / 267 / 256 -> 812 / 491 / 184 /

@@ -36,8 +36,8 @@ class IntensityImage {
   bool inside(double u, double v) const {
     return u >= 1.0 && v >= 1.0 && u <= width_ - 2.0 && v <= height_ - 2.0;
   }
-  // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v). The
-  // gradient is zero on the image's outermost rows and columns.
+  // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v). A border
+  // pixel of the 2x2 (weight 0 within inside()) gets a zero gradient: no read beyond the image.
   IntensitySample sample(int level, double u, double v) const;
   // The bilinear intensity alone, as sample() gives it.
   double intensity(int level, double u, double v) const;

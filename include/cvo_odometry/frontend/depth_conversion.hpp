@@ -14,7 +14,8 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
                       double max_depth);
 
 // The floats that bound [min_depth, max_depth] (the least float >= min_depth, the greatest <=
-// max_depth): comparing float depths with them keeps exactly the depths within the doubles.
+// max_depth): comparing float depths with them keeps exactly the depths within the doubles
+// (an infinite max_depth becomes the largest float: +inf depths are dropped).
 std::pair<float, float> floatDepthRange(double min_depth, double max_depth);
 
 }  // namespace cvo
