@@ -30,7 +30,8 @@ cv::Mat depthToMetres(const cv::Mat& depth, double units_per_metre, double min_d
   const float inf = std::numeric_limits<float>::infinity();
   cv::Mat metres(depth.size(), CV_32FC1);
   // Compared in float: the same depths, and the loops vectorise.
-  const auto [lo, hi] = floatDepthRange(min_depth, max_depth);
+  const std::pair<float, float> range = floatDepthRange(min_depth, max_depth);
+  const float lo = range.first, hi = range.second;  // C++17 lambdas capture no bindings
   auto keep = [&](float d) { return d > 0.0f && d < inf && d >= lo && d <= hi; };
   if (depth.depth() == CV_16U) {
     const float scale = static_cast<float>(1.0 / units_per_metre);
