@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "cvo_odometry/frontend/depth_conversion.hpp"
 
 namespace cvo {
 
@@ -38,10 +41,17 @@ double smoothDisparity(const cv::Mat& depth, double x, double y, double focal_ba
 
 std::function<float(float)> depthAtNewOffset(double from, double to, double focal_baseline,
                                              double min_depth, double max_depth) {
-  return [change = to - from, focal_baseline, min_depth, max_depth](float depth) {
+  // Judged in float against the front end's bounds: a moved depth beyond float's range (a
+  // disparity near 0 after the change) would otherwise become an infinite corner.
+  const std::pair<float, float> range = floatDepthRange(min_depth, max_depth);
+  return [change = to - from, focal_baseline, lo = range.first, hi = range.second](float depth) {
     const double disparity = focal_baseline / depth + change;
-    const double moved = disparity > 0.0 ? focal_baseline / disparity : NAN;
-    return moved >= min_depth && moved <= max_depth ? static_cast<float>(moved) : NAN;
+    if (!(disparity > 0.0)) return NAN;
+    const double largest = std::numeric_limits<float>::max();
+    const double moved = focal_baseline / disparity;
+    if (!(moved <= largest)) return NAN;
+    const float result = static_cast<float>(moved);
+    return result >= lo && result <= hi ? result : NAN;
   };
 }
 

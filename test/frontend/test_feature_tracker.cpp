@@ -3,9 +3,12 @@
 // destroyed while that thread runs waits for it.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <opencv2/imgproc.hpp>
 
 #include "cvo_odometry/frontend/depth_conversion.hpp"
+#include "cvo_odometry/frontend/disparity_offset_calibration.hpp"
 #include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
@@ -70,4 +73,27 @@ TEST(FeatureTracker, ResetOrDestructionWhileCornersAreFoundIsSafe) {
   const cvo::MotionPrior after_reset = tracker.track(second.grey, second.depth, K);
   EXPECT_FALSE(after_reset.solved);
   EXPECT_NE(after_reset.problem.find("no corners"), std::string::npos) << after_reset.problem;
+}
+
+// A new disparity offset moves the kept corners along their rays: with the tracker's unbounded
+// range (what the pipeline gives it) corners beyond the cloud's max_depth stay and the next frame
+// is solved from them; the cloud's bound would have dropped every one of these far corners.
+TEST(FeatureTracker, RemappedCornersBeyondTheCloudsMaxDepthStay) {
+  const cvo::TumSequence sequence(kTum);
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  GreyFrame first = load(sequence, 0), second = load(sequence, 1);
+  first.depth *= 100.0;  // 50-200 m: beyond a 40 m cap
+  second.depth *= 100.0;
+  const double focal_baseline = 388.0, cap = 40.0;
+  cvo::FeatureTracker unbounded({}), capped({});
+  unbounded.track(first.grey, first.depth, K);
+  capped.track(first.grey, first.depth, K);
+  const double infinite = std::numeric_limits<double>::infinity();
+  unbounded.remapDepths(cvo::depthAtNewOffset(0.0, 0.05, focal_baseline, 0.1, infinite));
+  capped.remapDepths(cvo::depthAtNewOffset(0.0, 0.05, focal_baseline, 0.1, cap));
+  EXPECT_TRUE(unbounded.seeded());
+  EXPECT_FALSE(capped.seeded());
+  const cvo::MotionPrior prior = unbounded.track(second.grey, second.depth, K);
+  ASSERT_TRUE(prior.solved) << prior.problem;
+  EXPECT_GT(prior.inliers, 100);
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -323,6 +324,11 @@ TEST(DisparityOffsetCalibration, MovesADepthToAnotherOffset) {
   EXPECT_TRUE(std::isnan(cvo::depthAtNewOffset(0.0, -1.0, fb, 1.0, 1e9)(800.0f)));  // d 0.5 - 1
   EXPECT_TRUE(std::isnan(cvo::depthAtNewOffset(0.0, -0.5, fb, 1.0, 55.0)(52.0f)));  // to 55.6 m
   EXPECT_TRUE(std::isnan(to_half(std::nanf(""))));
+  // The tracker's unbounded range: a depth beyond float's range is none, not an infinite corner.
+  const double unbounded = std::numeric_limits<double>::infinity();
+  const float far = std::numeric_limits<float>::infinity();
+  EXPECT_TRUE(std::isnan(cvo::depthAtNewOffset(0.0, 1e-38, fb, 1.0, unbounded)(far)));
+  EXPECT_NEAR(cvo::depthAtNewOffset(0.0, 1e-30, fb, 1.0, unbounded)(far), 4e32, 1e27);
   cvo::DisparityOffsetCalibration calibration(0.0, true, cvo::DisparityOffsetOptions{});
   EXPECT_FALSE(calibration.focalBaseline().has_value());
 }
