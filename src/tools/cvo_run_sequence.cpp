@@ -161,8 +161,9 @@ int main(int argc, char** argv) {
         std::cerr << result.stats.selection.selected << " points";
         if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
-                    << std::fixed << update.report.time_ms << " ms, cosine " << std::setprecision(3)
-                    << update.cosine << ", guess " << cvo::toString(update.guess) << ", tracks "
+                    << std::fixed << update.report.time_ms << " ms (frame " << result.total_ms
+                    << " ms), cosine " << std::setprecision(3) << update.cosine << ", guess "
+                    << cvo::toString(update.guess) << ", tracks "
                     << (result.prior ? result.prior->inliers : 0) << " agree "
                     << update.track_agreement << " (median " << update.track_error_px << " px of "
                     << update.track_flow_px << " px), "

@@ -163,8 +163,9 @@ void visitSettings(CvoParams& p, V&& v) {
                 "... and it is the guess with this fraction of its tracks as inliers", 0.0, 1.0},
     p.min_prior_inlier_ratio);
   v(SettingInfo{"guess_disagreement_translation", "guess",
-                "prior and constant velocity further apart than this (m) are both tried", 0.001,
-                100.0},
+                "prior and constant velocity further apart than this (m) are both tried (the "
+                "second unless the first agrees with every track)",
+                0.001, 100.0},
     p.guess_disagreement_translation);
   v(SettingInfo{"guess_disagreement_rotation", "guess",
                 "... or turned further apart than this (deg)", 0.01, 180.0},
