@@ -32,14 +32,20 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
   order_.resize(count);
   std::iota(order_.begin(), order_.end(), 0u);
   if (dense_) {
-    // Counting sort: stable, so the order within a cell is the input order.
-    start_.assign(static_cast<std::size_t>(cells) + 1, 0u);
+    // Counting sort: stable, so the order within a cell is the input order. The slots are
+    // filled from each cell's end, the points taken backwards, so that start_ itself counts
+    // down to each cell's first slot (no second cell-sized array: TUM's finest grids have
+    // 0.5M cells for 9k points).
+    const auto cell_count = static_cast<std::size_t>(cells);
+    start_.assign(cell_count + 1, 0u);
     for (std::size_t i = 0; i < count; ++i)
       ++start_[cell_of[i] + 1];
-    std::partial_sum(start_.begin(), start_.end(), start_.begin());
-    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < count; ++i)
-      order_[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());  // [c + 1]: cell c's end
+    for (std::size_t i = count; i-- > 0;)
+      order_[--start_[cell_of[i] + 1]] = static_cast<std::uint32_t>(i);
+    // [c + 1] is now cell c's first slot: shift down and close with the end.
+    std::copy(start_.begin() + 1, start_.end(), start_.begin());
+    start_[cell_count] = static_cast<std::uint32_t>(count);
     cells_.clear();
   } else {
     std::stable_sort(order_.begin(), order_.end(),
