@@ -173,6 +173,31 @@ TEST(RgbdFrontend, BeyondMaxDepthOnlyTheTrackerSees) {
   }
 }
 
+// An empty frame names what emptied it: the crop when the depth is only in the cropped rows.
+TEST(RgbdFrontend, AnEmptyFrameNamesTheCropOrTheRange) {
+  const TumFrame f = loadFrame(5);
+  const auto message = [&](int crop_top_rows, double max_depth) {
+    cvo::RgbdFrontendOptions o = options(cvo::SelectorKind::kGrid, 5000.0);
+    o.cloud.crop_top_rows = crop_top_rows;
+    o.cloud.max_depth = max_depth;
+    cvo::RgbdCloudBuilder builder(o);
+    cv::Mat depth = f.depth.clone();
+    depth.rowRange(100, depth.rows).setTo(0);  // depth in the top 100 rows only
+    try {
+      builder.build({f.image, depth, pinholeFr1(), cv::Mat()}, nullptr);
+    } catch (const cvo::EmptyFrameError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(100, 10.0), "no pixel below the top 100 rows (crop_top_rows) has valid depth");
+  EXPECT_EQ(message(480, 10.0), "crop_top_rows (480) leaves none of the image's 480 rows");
+  EXPECT_EQ(
+      message(50, 0.3).rfind("no pixel below the top 50 rows (crop_top_rows) has depth in [0.1", 0),
+      0u);
+  EXPECT_EQ(message(0, 10.0), "no error");
+}
+
 // The range is the closed interval of the given doubles, also for the floats next to its ends
 // (0.7 and 2.3 round below and above themselves as floats; 0.1 above).
 TEST(RgbdFrontend, DepthRangeKeepsExactlyTheFloatsWithinIt) {
