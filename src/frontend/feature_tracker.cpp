@@ -22,8 +22,8 @@ namespace {
 constexpr std::size_t kMinTracks = 8;
 // Pyramid levels of the backward (checking) track.
 constexpr int kBackwardLevels = 1;
-// Rows above the crop that the corner measure reads.
-constexpr int kCornerContextRows = 2;
+// A corner's response is at least this fraction of the strongest one's (OpenCV's suggestion).
+constexpr double kCornerQuality = 0.01;
 
 }  // namespace
 
@@ -104,18 +104,10 @@ void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const Pinho
                           int crop_top_rows, std::vector<cv::Mat> levels) {
   last_pyramid_ = std::move(levels);
   if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
-  // Only the rows below the crop can hold a corner: the search runs there, with the 2 rows above
-  // that the corner measure (3x3 Sobel, 3x3 block) reads, so the corners are those of the whole
-  // image (KITTI: a quarter of the image skipped).
-  const int first = std::clamp(crop_top_rows - kCornerContextRows, 0, grey.rows);
-  const cv::Range band(first, grey.rows);
-  cv::Mat mask = (depth.rowRange(band) == depth.rowRange(band));  // NaN: no depth
-  mask.rowRange(0, std::clamp(crop_top_rows - first, 0, mask.rows)).setTo(0);
-  std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(grey.rowRange(band), corners, options_.max_corners, 0.01,
-                          options_.min_distance, mask, 3, false);
-  for (cv::Point2f& corner : corners)
-    corner.y += static_cast<float>(first);
+  // Only the rows below the crop, with depth, can hold a corner (KITTI: a quarter of the image
+  // skipped); the measure reads the rows above them.
+  const std::vector<cv::Point2f>& corners = corners_.find(
+      grey, depth, crop_top_rows, options_.max_corners, kCornerQuality, options_.min_distance);
   const std::vector<cv::Point2f> rays = normalisedRays(corners, K);
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const float z = depth.at<float>(cvRound(corners[k].y), cvRound(corners[k].x));

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "cvo_odometry/core/motion_prior.hpp"
+#include "cvo_odometry/frontend/min_eigen_corners.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 
 namespace cvo {
@@ -72,6 +73,7 @@ class FeatureTracker {
                     const PinholeIntrinsics& intrinsics) const;
 
   FeatureTrackerOptions options_;
+  MinEigenCorners corners_;            // used by seed() only
   std::vector<cv::Point3f> points_;    // the previous frame's camera frame
   std::vector<cv::Point2f> pixels_;    // where the previous image sees them
   std::vector<cv::Mat> last_pyramid_;  // of the previous image
