@@ -30,7 +30,6 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
                               kernels::cellCoordinate(shape_, p[2], 2));
   }
   order_.resize(count);
-  std::iota(order_.begin(), order_.end(), 0u);
   if (dense_) {
     // Counting sort: stable, so the order within a cell is the input order. The slots are
     // filled from each cell's end, the points taken backwards, so that start_ itself counts
@@ -48,6 +47,7 @@ void VoxelGrid::build(const float* positions, std::size_t count, float cell_size
     start_[cell_count] = static_cast<std::uint32_t>(count);
     cells_.clear();
   } else {
+    std::iota(order_.begin(), order_.end(), 0u);
     std::stable_sort(order_.begin(), order_.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return cell_of[a] < cell_of[b]; });
     std::size_t occupied = 0;

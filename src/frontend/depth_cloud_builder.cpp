@@ -122,7 +122,8 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
   if (valid_count == 0) {
-    // Named by what emptied it: no depth at all, the crop, or the range.
+    // Named by what emptied it: no depth at all, the crop, or the range (RGB-D depths nearer
+    // than min_depth are already NaN here: the converter drops them).
     const int cropped = std::min(options_.crop_top_rows, depth.rows);
     const std::string where =
         cropped > 0 ? "below the top " + std::to_string(cropped) + " rows (crop_top_rows) " : "";

@@ -41,8 +41,9 @@ double smoothDisparity(const cv::Mat& depth, double x, double y, double focal_ba
 
 std::function<float(float)> depthAtNewOffset(double from, double to, double focal_baseline,
                                              double min_depth, double max_depth) {
-  // Judged in float against the front end's bounds: a moved depth beyond float's range (a
-  // disparity near 0 after the change) would otherwise become an infinite corner.
+  // Judged in float against the front end's bounds, as the front end judges depths; a moved
+  // depth beyond float's range (a disparity near 0 after the change) is none: converting it to
+  // float is undefined.
   const std::pair<float, float> range = floatDepthRange(min_depth, max_depth);
   return [change = to - from, focal_baseline, lo = range.first, hi = range.second](float depth) {
     const double disparity = focal_baseline / depth + change;

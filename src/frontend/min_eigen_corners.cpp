@@ -76,7 +76,7 @@ void MinEigenCorners::responseRow(int row, int above, int below) {
   for (int x = 0; x < w; ++x) {
     // The smaller eigenvalue of [a b; b c] as det / (the larger one): no cancellation at edges.
     // The sums are exact in float (< 2^24), the determinant in double (< 2^53). Branch-free
-    // (this file is built without errno from sqrt) so that the loop vectorises; 0 where flat.
+    // (and sqrt sets no errno: -fno-math-errno) so that the loop vectorises; 0 where flat.
     const std::int32_t a = xx0[x] + xx1[x] + xx2[x];
     const std::int32_t b = xy0[x] + xy1[x] + xy2[x];
     const std::int32_t c = yy0[x] + yy1[x] + yy2[x];
@@ -93,6 +93,10 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
                                                       double quality, double min_distance) {
   if (grey.type() != CV_8UC1 || depth.type() != CV_32FC1 || depth.size() != grey.size()) {
     throw std::invalid_argument("corners: an 8-bit grey image and a float depth of its size");
+  }
+  if (!(quality > 0.0 && quality <= 1.0) || !(min_distance >= 0.0) ||
+      !std::isfinite(min_distance)) {
+    throw std::invalid_argument("corners: quality must be in (0, 1] and min_distance >= 0");
   }
   corners_.clear();
   const int w = grey.cols, h = grey.rows;
@@ -174,6 +178,8 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     }
     return corners_;
   }
+  // Beyond the image's diagonal every pair is nearer: the same corners as at the diagonal.
+  min_distance = std::min(min_distance, std::hypot(w, h) + 1.0);
   // Kept corners by cell; cells within `reach` of a corner's cell hold every kept corner nearer
   // than min_distance.
   const int cell = static_cast<int>(std::lround(min_distance));

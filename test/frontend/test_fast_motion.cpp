@@ -247,8 +247,12 @@ TEST_P(TumStrides, EveryPairTrackedAndBetterThanThePrior) {
   EXPECT_EQ(report.silent.failures, 0u);
   EXPECT_LT(report.rpe_frame.translation_rmse, prior.rpe_frame.translation_rmse);
   EXPECT_LT(report.rpe_frame.rotation_rmse_deg, prior.rpe_frame.rotation_rmse_deg);
+  // Most frames are such (11 of 12 at stride 3, 5 of 7 at stride 5); without the motion
+  // history there is no constant-velocity guess to skip.
   EXPECT_GT(r.agreeing_prior_frames, r.tracked / 2);
-  EXPECT_EQ(r.agreeing_prior_attempts, r.agreeing_prior_frames);
+  if (!forget) {
+    EXPECT_EQ(r.agreeing_prior_attempts, r.agreeing_prior_frames);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Strides, TumStrides,

@@ -1,13 +1,14 @@
 // Shi-Tomasi corners as cv::goodFeaturesToTrack finds them (the minimum eigenvalue of the 3x3
 // sums of 3x3 Sobel gradient products, 3x3 local maxima above a fraction of the strongest,
-// strongest first, none nearer than a distance to a stronger one), in one pass over the image
-// that keeps three rows of gradient products: OpenCV builds five full-size float images for it
-// (two gradients, three products), 4 ms a 640x480 frame here against ~1 ms. The products are
-// summed exactly in integers (OpenCV: in float), so corners of equal strength in float may come
-// in another order.
+// strongest first, none nearer than a distance to a stronger kept one), in one pass over the
+// image that keeps three rows of gradient products: OpenCV builds five full-size float images
+// for it (two gradients, three products), 2-4 ms a 640x480 frame here against 1.1 ms. The
+// products are summed exactly in integers (OpenCV: in float), so corners of equal strength in
+// float may come in another order.
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -17,9 +18,10 @@ namespace cvo {
 class MinEigenCorners {
  public:
   // Corners of `grey` (CV_8UC1) at rows >= first_row where `depth` (CV_32FC1, same size) is not
-  // NaN, at least `min_distance` px apart, at most `max_corners`, each at least `quality` times
-  // the strongest such pixel's response. Gradients read the rows above first_row where there
-  // are any (the image's border is reflected, as OpenCV's default border).
+  // NaN, at least `min_distance` px apart (0: any), at most `max_corners` (<= 0: no limit),
+  // each above `quality` (in (0, 1]) times the strongest such pixel's response. Gradients read
+  // the rows above first_row where there are any (the image's border is reflected, as OpenCV's
+  // default border). Bad arguments throw std::invalid_argument.
   const std::vector<cv::Point2f>& find(const cv::Mat& grey, const cv::Mat& depth, int first_row,
                                        int max_corners, double quality, double min_distance);
 
