@@ -119,20 +119,20 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   cv::Mat valid;  // NaN is outside every range
   const auto [lo, hi] = floatDepthRange(options_.min_depth, options_.max_depth);
   cv::inRange(depth, lo, hi, valid);
-  valid.rowRange(0, std::min(options_.crop_top_rows, valid.rows)).setTo(0);
+  const int cropped = std::min(options_.crop_top_rows, depth.rows);
+  valid.rowRange(0, cropped).setTo(0);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
   if (valid_count == 0) {
     // Named by what emptied it: no depth at all, the crop, or the range (RGB-D depths nearer
     // than min_depth are already NaN here: the converter drops them).
-    const int cropped = std::min(options_.crop_top_rows, depth.rows);
-    const std::string where =
-        cropped > 0 ? "below the top " + std::to_string(cropped) + " rows (crop_top_rows) " : "";
     if (cropped == depth.rows) {
       throw EmptyFrameError("crop_top_rows (" + std::to_string(options_.crop_top_rows) +
                             ") leaves none of the image's " + std::to_string(depth.rows) + " rows");
     }
-    if (cv::countNonZero(depth.rowRange(cropped, depth.rows) ==
-                         depth.rowRange(cropped, depth.rows)) == 0) {
+    const std::string where =
+        cropped > 0 ? "below the top " + std::to_string(cropped) + " rows (crop_top_rows) " : "";
+    const cv::Mat kept_rows = depth.rowRange(cropped, depth.rows);
+    if (cv::countNonZero(kept_rows == kept_rows) == 0) {
       throw EmptyFrameError("no pixel " + where + "has valid depth");
     }
     throw EmptyFrameError("no pixel " + where + "has depth in [" +
