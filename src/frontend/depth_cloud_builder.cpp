@@ -12,6 +12,7 @@
 #include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/depth_conversion.hpp"
 #include "cvo_odometry/frontend/empty_frame_error.hpp"
+#include "cvo_odometry/frontend/point_spacing.hpp"
 #include "cvo_odometry/frontend/semantic_image.hpp"
 
 namespace cvo {
@@ -30,6 +31,10 @@ void CloudBuilderOptions::validate() const {
                                 std::to_string(max_depth) + "] makes no sense");
   }
   if (crop_top_rows < 0) throw std::invalid_argument("crop_top_rows must be >= 0");
+  if (!(min_point_spacing >= 0.0 && min_point_spacing <= 1e3)) {
+    throw std::invalid_argument("min_point_spacing must be in [0, 1000] m, got " +
+                                std::to_string(min_point_spacing));
+  }
   if (selector.min_points < 1 || selector.max_points < selector.min_points) {
     throw std::invalid_argument("point count range [" + std::to_string(selector.min_points) + ", " +
                                 std::to_string(selector.max_points) + "] makes no sense");
@@ -148,11 +153,16 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   cloud.reserve(pixels.size());
   std::vector<float> probabilities(
       static_cast<std::size_t>(std::max(options_.semantic_classes, 1)));
+  PointSpacing spacing(options_.min_point_spacing, pixels.size());
   for (std::size_t k = 0; k < pixels.size(); ++k) {
     const cv::Point& p = pixels[k];
     if (semantics && !semantics->probabilities(p.x, p.y, probabilities.data())) continue;
     const float z = depth.at<float>(p);
     const Eigen::Vector3f position(rays[k].x * z, rays[k].y * z, z);
+    if (!spacing.admit(position)) {
+      ++local.spaced_out;
+      continue;
+    }
     float features[5];
     colorFeaturesAt(image, grey, p.x, p.y, features);
     cloud.add(position, features, semantics ? probabilities.data() : nullptr);

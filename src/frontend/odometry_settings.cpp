@@ -11,6 +11,9 @@ void OdometrySettings::validate() const {
   stereo.validate();
   features.validate();
   if (!(depth_scale > 0.0)) throw std::invalid_argument("depth_scale must be positive");
+  if (!(point_spacing >= 0.0 && point_spacing <= 2.0)) {
+    throw std::invalid_argument("point_spacing must be in [0, 2] (a fraction of ell_min)");
+  }
   if (!std::isfinite(disparity_offset)) {
     throw std::invalid_argument("disparity_offset must be finite");
   }
@@ -20,6 +23,7 @@ void OdometrySettings::validate() const {
 CloudBuilderOptions OdometrySettings::cloudOptions() const {
   CloudBuilderOptions options = cloud;
   if (!cvo.photometric_rotation) options.image_levels = 0;
+  options.min_point_spacing = point_spacing * cvo.ell_min;
   return options;
 }
 

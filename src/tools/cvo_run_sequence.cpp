@@ -159,6 +159,9 @@ int main(int argc, char** argv) {
           continue;
         }
         std::cerr << result.stats.selection.selected << " points";
+        if (result.stats.spaced_out > 0) {
+          std::cerr << " (" << result.stats.spaced_out << " left out for point_spacing)";
+        }
         if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
                     << std::fixed << update.report.time_ms << " ms (frame " << result.total_ms

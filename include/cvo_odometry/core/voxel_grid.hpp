@@ -67,10 +67,12 @@ class VoxelGrid {
   const float* sortedY() const { return ys_.data(); }
   const float* sortedZ() const { return zs_.data(); }
 
- private:
+  // The hash key of cell (x, y, z): 21 bits an axis, distinct for coordinates within
+  // +-kSparseReach.
   static constexpr float kSparseReach = 1 << 20;
   static std::uint64_t key(int x, int y, int z);
 
+ private:
   kernels::DenseGridShape shape_{{0.0f, 0.0f, 0.0f}, 0.0f, {0, 0, 0}};
   bool dense_ = true;
   std::vector<std::uint32_t> start_;  // dense: first sorted point of each cell, plus the end

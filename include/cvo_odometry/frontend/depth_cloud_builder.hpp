@@ -24,6 +24,10 @@ struct CloudBuilderOptions {
   double max_depth = 10.0;
   int crop_top_rows = 0;  // rows at the top never selected (KITTI: sky and stereo-less band)
   SelectorOptions selector;
+  // At most one point of a frame in each cube of this edge (metres; 0: every selected pixel),
+  // the first selected: pixels chosen in the image crowd together in 3D on near surfaces, where
+  // each point adds kernel pairs to every registration sum (PointSpacing).
+  double min_point_spacing = 0.0;
   // Blur levels of the grey image attached to each cloud for the photometric rotation stage
   // (sigmas ..., 2, 1, 0 px; 0: no image attached).
   int image_levels = 2;
@@ -36,6 +40,7 @@ struct CloudBuilderOptions {
 
 struct FrontendStats {
   SelectionStats selection;
+  std::size_t spaced_out = 0;  // selected points left out for min_point_spacing
   std::size_t valid_depth_pixels = 0;
   double matching_ms = 0.0;  // stereo matching, part of time_ms
   double time_ms = 0.0;

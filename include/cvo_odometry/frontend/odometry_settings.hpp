@@ -19,7 +19,11 @@ struct OdometrySettings {
   CloudBuilderOptions cloud;
   StereoMatcherOptions stereo;
   FeatureTrackerOptions features;
-  double depth_scale = 1000.0;    // 16-bit depth units per metre
+  double depth_scale = 1000.0;  // 16-bit depth units per metre
+  // The cloud's least point spacing as a fraction of ell_min (CloudBuilderOptions'
+  // min_point_spacing = point_spacing * ell_min; README "Point spacing"). Off by default: it
+  // pays off only for near scenes, and there it trades accuracy for time.
+  double point_spacing = 0.0;
   double disparity_offset = 0.0;  // px added to every stereo disparity (README "Stereo scale")
   bool estimate_disparity_offset = true;  // self-calibrate it from the feature tracks
   DisparityOffsetOptions disparity_offset_estimate;
@@ -44,6 +48,10 @@ void visitSettings(OdometrySettings& s, V&& v) {
     s.cloud.selector.min_points);
   v(SettingInfo{"max_points", "points", "most selected points per frame", 100, 400000},
     s.cloud.selector.max_points);
+  v(SettingInfo{"point_spacing", "points",
+                "at most one point in each cube of this edge, as a fraction of ell_min (0: off)",
+                0.0, 2.0},
+    s.point_spacing);
   v(SettingInfo{"min_depth", "depth", "nearer points are not used (m)", 0.0, 1000.0},
     s.cloud.min_depth);
   v(SettingInfo{"max_depth", "depth",
