@@ -4,8 +4,10 @@
 // all of them.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <set>
+#include <string>
 #include <tuple>
 
 #include <opencv2/core.hpp>
