@@ -226,7 +226,7 @@ void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float 
   const float radius2 = radius * radius;
   const float* tgt = target_->positionData().data();
   const float* src = source_->positionData().data();
-  const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
+  const float *xs = grid_->sortedX(), *ys = grid_->sortedY(), *zs = grid_->sortedZ();
   Block& block = blocks_[b];
   block.offsets.assign(1, 0);
   block.clear();
@@ -240,7 +240,7 @@ void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float 
       // Geometry only: the radius test is the joint-distance test.
       // Every slot of the range written, the next one's start moved on only past a kept point:
       // no branch to mispredict (about a third of a range is kept).
-      grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+      grid_->forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
         block.reserve(block.count + (last - first), false);
         float *bx = block.x.data(), *by = block.y.data(), *bz = block.z.data();
         std::size_t kept = block.count;
@@ -254,7 +254,7 @@ void CpuBackend::buildBlock(std::size_t b, const float* pose, double ell, float 
         block.count = kept;
       });
     } else {
-      grid_.forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
+      grid_->forEachWithin(z, radius, [&](std::uint32_t i, float distance2) {
         const float appearance_d2 = appearanceDistance2(i, j);
         if (distance2 * inv_ell2 + appearance_d2 >= reach2) return;
         const float* x = tgt + 3 * i;
@@ -326,7 +326,7 @@ float CpuBackend::appearanceDistance2(std::uint32_t i, std::size_t j) const {
 
 void CpuBackend::ensureGrid(float radius) {
   if (radius == grid_radius_) return;
-  grid_.build(target_->positionData().data(), target_->size(), radius);
+  grid_ = &grids_.grid(target_->positionData().data(), target_->size(), radius);
   grid_radius_ = radius;
 }
 
@@ -384,14 +384,14 @@ kernels::MomentSums CpuBackend::sumFromGrid(const Eigen::Isometry3d& T, double e
 kernels::MomentSums CpuBackend::gridMoments(const Eigen::Isometry3d& T, double ell) {
   return sumFromGrid(T, ell, [&](std::size_t, const float* z, float radius, float inv_two_ell2) {
     // The grid is (re)built by sumFromGrid: its arrays are read here, after that.
-    const float *xs = grid_.sortedX(), *ys = grid_.sortedY(), *zs = grid_.sortedZ();
+    const float *xs = grid_->sortedX(), *ys = grid_->sortedY(), *zs = grid_->sortedZ();
     // A point's ranges copied into one run: one vectorised loop a point, not one a range
     // (pairs beyond the cut-off in the ranges weigh 0 in the loop).
     thread_local std::vector<float> run_x, run_y, run_z;
     run_x.clear();
     run_y.clear();
     run_z.clear();
-    grid_.forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
+    grid_->forEachRange(z, radius, [&](std::uint32_t first, std::uint32_t last) {
       run_x.insert(run_x.end(), xs + first, xs + last);
       run_y.insert(run_y.end(), ys + first, ys + last);
       run_z.insert(run_z.end(), zs + first, zs + last);
@@ -407,7 +407,7 @@ kernels::MomentSums CpuBackend::oneOffMoments(const Eigen::Isometry3d& T, double
   return sumFromGrid(T, ell, [&](std::size_t j, const float* z, float radius, float inv_two_ell2) {
     kernels::PointSums sums;
     kernels::clear(sums);
-    grid_.forEachWithin(z, radius, [&](std::uint32_t i, float) {
+    grid_->forEachWithin(z, radius, [&](std::uint32_t i, float) {
       const float* x = tgt + 3 * i;
       const float appearance = kernels::appearanceWeight(constants_, appearanceDistance2(i, j));
       const float a = kernels::retainedPairWeight(appearance, x[0] - z[0], x[1] - z[1], x[2] - z[2],

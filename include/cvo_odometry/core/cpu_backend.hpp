@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cvo_odometry/core/block_pool.hpp"
+#include "cvo_odometry/core/grid_cache.hpp"
 #include "cvo_odometry/core/registration_backend.hpp"
 #include "cvo_odometry/core/voxel_grid.hpp"
 
@@ -82,7 +83,8 @@ class CpuBackend : public RegistrationBackend {
   // After a lengthscale decrease: the joint distance only grows as ell shrinks, so the new list
   // is a filter of the old one, with the old margin less what the block moved since.
   void refilterBlock(std::size_t b, const float* pose, double ell, double margin);
-  // The target's grid with this cell size (kept while the problem and size stay).
+  // The target's grid with this cell size (kept while the problem and size stay; a keyframe's
+  // across the frames registered to it, from grids_).
   void ensureGrid(float radius);
   // Moments at the cut-off radius: from a block's list where it holds, else straight from the
   // grid, point_sums(j, T z_j, radius, 1 / (2 ell^2)) giving each source point's sums.
@@ -104,7 +106,8 @@ class CpuBackend : public RegistrationBackend {
   kernels::KernelConstants constants_{};
   bool constant_appearance_ = true;  // geometry only: every pair's appearance is s^2
   double cutoff2_ = 0.0;             // retained iff scaled joint distance^2 below this
-  VoxelGrid grid_;
+  GridCache grids_;                  // the target's grid, and the last other one (a keyframe's)
+  const VoxelGrid* grid_ = nullptr;  // the target's, from grids_
   float grid_radius_ = -1.0f;  // the cell size grid_ was built with, -1: none for this problem
   double direct_ell_ = -1.0;   // lengthscale of the last evaluation read from the grid
   double ell_min_ = 0.0;
