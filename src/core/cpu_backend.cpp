@@ -137,10 +137,13 @@ void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& sour
   direct_ell_ = -1.0;
   ell_min_ = params.ell_min;
   grid_radius_ = -1.0f;
-  // Blocks keep their storage across problems: no reallocation (and page faults) per level.
-  blocks_.resize((source.size() + kBlockSize - 1) / kBlockSize);
-  for (Block& block : blocks_)
-    block.listed = false;
+  // Blocks keep their storage across problems, those beyond a smaller problem's count too: the
+  // registration's levels, its self products and each frame alternate problem sizes, and a
+  // block made anew grew its lists from nothing again (reallocations and page faults).
+  block_count_ = (source.size() + kBlockSize - 1) / kBlockSize;
+  if (blocks_.size() < block_count_) blocks_.resize(block_count_);
+  for (std::size_t b = 0; b < block_count_; ++b)
+    blocks_[b].listed = false;
 }
 
 double CpuBackend::movedSinceListed(const Block& block, const Eigen::Isometry3d& T) {
@@ -156,7 +159,7 @@ bool CpuBackend::blockHolds(const Block& block, const Eigen::Isometry3d& T, doub
 }
 
 bool CpuBackend::candidatesHold(const Eigen::Isometry3d& T, double ell) const {
-  return std::all_of(blocks_.begin(), blocks_.end(),
+  return std::all_of(blocks_.begin(), blocks_.begin() + static_cast<std::ptrdiff_t>(block_count_),
                      [&](const Block& block) { return blockHolds(block, T, ell); });
 }
 
@@ -165,10 +168,10 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
   using Update = ListUpdate;
   std::vector<Update>& updates = block_updates_;
   std::vector<double>& margins = block_margins_;
-  updates.assign(blocks_.size(), Update::kBuild);
-  margins.assign(blocks_.size(), kSkin);
+  updates.assign(block_count_, Update::kBuild);
+  margins.assign(block_count_, kSkin);
   bool any_build = false, any_change = false;
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+  for (std::size_t b = 0; b < block_count_; ++b) {
     const Block& block = blocks_[b];
     if (blockHolds(block, T, ell)) {
       updates[b] = Update::kKeep;
@@ -191,7 +194,7 @@ void CpuBackend::ensureCandidates(const Eigen::Isometry3d& T, double ell) {
   if (any_build) ensureGrid(radius);
   float pose[12];
   toRowMajor3x4(T, pose);
-  pool_.run(blocks_.size(), [&](std::size_t b) {
+  pool_.run(block_count_, [&](std::size_t b) {
     if (updates[b] == Update::kKeep) return;
     Block& block = blocks_[b];
     block.listed = false;  // until the list is whole again (an allocation may throw)
@@ -296,8 +299,8 @@ void CpuBackend::refilterBlock(std::size_t b, const float* pose, double ell, dou
 
 template <class Sums, class Fill>
 Sums CpuBackend::sumBlocks(Fill&& fill) const {
-  std::vector<Sums> partial(blocks_.size());
-  pool_.run(blocks_.size(), [&](std::size_t b) {
+  std::vector<Sums> partial(block_count_);
+  pool_.run(block_count_, [&](std::size_t b) {
     kernels::clear(partial[b]);
     fill(b, partial[b]);
   });

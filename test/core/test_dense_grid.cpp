@@ -174,6 +174,51 @@ TEST(CpuBackendGridSums, MatchTheCandidateLists) {
   }
 }
 
+// One backend through problems of other sizes and targets (a registration's levels, its self
+// products, the next frame's): its blocks and grids, kept from the earlier problems, give the
+// sums a backend new to each problem gives.
+TEST(CpuBackendReuse, SumsDoNotDependOnTheProblemsBefore) {
+  const std::string clouds = std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/";
+  const cvo::LabeledCloud large = cvo::readCloud(clouds + "frame11_8000.cloud");
+  const cvo::LabeledCloud small = cvo::readCloud(clouds + "frame11_3000.cloud");
+  const cvo::LabeledCloud keyframe = cvo::readCloud(clouds + "frame10_8000.cloud");
+  ASSERT_GT(large.size(), 2 * small.size());
+  cvo::CvoParams params;
+  params.use_color = false;
+  params.ell_min = 0.02;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() << 0.004, -0.002, 0.003;
+  struct Problem {
+    const cvo::LabeledCloud* target;
+    const cvo::LabeledCloud* source;
+    const char* name;
+  };
+  const Problem problems[] = {{&keyframe, &large, "keyframe <- large"},
+                              {&small, &small, "small <- small"},
+                              {&keyframe, &large, "keyframe <- large, again"},
+                              {&large, &large, "large <- large"},
+                              {&keyframe, &small, "keyframe <- small"}};
+  cvo::CpuBackend reused(2);
+  for (const Problem& problem : problems) {
+    for (const double ell : {0.02, 0.05}) {
+      const std::string what = std::string(problem.name) + ", ell " + std::to_string(ell);
+      reused.setProblem(*problem.target, *problem.source, params);
+      cvo::CpuBackend fresh(2);
+      fresh.setProblem(*problem.target, *problem.source, params);
+      const cvo::kernels::MomentSums a = reused.moments(T, ell);
+      const cvo::kernels::MomentSums b = fresh.moments(T, ell);
+      ASSERT_GT(b.pairs, 1000u) << what;
+      EXPECT_EQ(a.pairs, b.pairs) << what;
+      EXPECT_EQ(a.weight, b.weight) << what;
+      const cvo::kernels::CurvatureSums c = reused.curvature(T, ell);
+      const cvo::kernels::CurvatureSums d = fresh.curvature(T, ell);
+      EXPECT_EQ(c.moments.weight, d.moments.weight) << what;
+      for (int k = 0; k < 21; ++k)
+        EXPECT_EQ(c.hessian[k], d.hessian[k]) << what << ", hessian " << k;
+    }
+  }
+}
+
 }  // namespace
 
 namespace {

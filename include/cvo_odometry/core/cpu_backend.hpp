@@ -111,7 +111,8 @@ class CpuBackend : public RegistrationBackend {
   float grid_radius_ = -1.0f;  // the cell size grid_ was built with, -1: none for this problem
   double direct_ell_ = -1.0;   // lengthscale of the last evaluation read from the grid
   double ell_min_ = 0.0;
-  std::vector<Block> blocks_;
+  std::vector<Block> blocks_;    // the first block_count_ are this problem's
+  std::size_t block_count_ = 0;  // blocks of kBlockSize source points in this problem
   // ensureCandidates' per-block plan, kept to avoid an allocation a call.
   enum class ListUpdate : unsigned char { kKeep, kRefilter, kBuild };
   std::vector<ListUpdate> block_updates_;
