@@ -45,13 +45,18 @@ void CloudBuilderOptions::validate() const {
   }
 }
 
-std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
-                                                     const PinholeIntrinsics& K, int levels) {
+std::shared_ptr<const IntensityImage> intensityImage(
+    const cv::Mat& image, const PinholeIntrinsics& K, int levels,
+    const std::shared_ptr<FloatBufferPool>& buffers) {
   if (levels <= 0 || !CameraModel::supportsDistortion(K.distortion.size())) return nullptr;
   // Each level is written straight into its own buffer: no image is allocated and copied.
   std::vector<IntensityImage::Level> out(static_cast<std::size_t>(levels));
-  const auto header = [&image](IntensityImage::Level& level) {
-    level.values.resize(image.total());
+  const auto header = [&image, &buffers](IntensityImage::Level& level) {
+    if (buffers) {
+      level.values = buffers->take(image.total());
+    } else {
+      level.values.resize(image.total());
+    }
     return cv::Mat(image.rows, image.cols, CV_32F, level.values.data());
   };
   cv::Mat sharp = header(out.back());  // the last level: unblurred
@@ -62,8 +67,14 @@ std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
     cv::Mat blurred = header(level);
     cv::GaussianBlur(sharp, blurred, cv::Size(), level.blur_sigma);
   }
-  return std::make_shared<const IntensityImage>(
+  auto* built = new IntensityImage(
       image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion), std::move(out));
+  if (!buffers) return std::shared_ptr<const IntensityImage>(built);
+  return std::shared_ptr<const IntensityImage>(built, [buffers](IntensityImage* done) {
+    for (IntensityImage::Level& level : done->releaseLevels())
+      buffers->give(std::move(level.values));
+    delete done;
+  });
 }
 
 std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point2f>& pixels,
@@ -91,6 +102,9 @@ std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
 DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
     : options_(options), selector_(options.selector) {
   options_.validate();
+  // Enough for the levels of the frame being made and of one released before it.
+  level_buffers_ =
+      std::make_shared<FloatBufferPool>(2 * static_cast<std::size_t>(options_.image_levels));
 }
 
 LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth,
@@ -170,7 +184,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   if (cloud.size() == 0) {
     throw EmptyFrameError("every selected pixel belongs to an ignored class");
   }
-  cloud.setImage(intensityImage(image, intrinsics, options_.image_levels));
+  cloud.setImage(intensityImage(grey, intrinsics, options_.image_levels, level_buffers_));
   if (images) *images = FrameImages{grey, depth};
   local.valid_depth_pixels = valid_count;
   local.time_ms =

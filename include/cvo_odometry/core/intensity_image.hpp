@@ -6,6 +6,7 @@
 // owns OpenCV); the core only samples it.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "cvo_odometry/core/camera_model.hpp"
@@ -41,6 +42,10 @@ class IntensityImage {
   IntensitySample sample(int level, double u, double v) const;
   // The bilinear intensity alone, as sample() gives it.
   double intensity(int level, double u, double v) const;
+
+  // Moves the levels out, leaving the image without any: for a front end that reuses their
+  // buffers once the image is done with (call it only then).
+  std::vector<Level> releaseLevels() { return std::move(levels_); }
 
  private:
   int width_, height_;

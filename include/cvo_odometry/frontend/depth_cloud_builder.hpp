@@ -9,6 +9,7 @@
 
 #include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/frontend/float_buffer_pool.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 #include "cvo_odometry/frontend/point_selector.hpp"
 #include "cvo_odometry/frontend/ray_table.hpp"
@@ -55,10 +56,11 @@ struct FrameImages {
 };
 
 // The grey image for the photometric stage: `levels` blurs of `image` (8-bit BGR or grey), or
-// null when levels is 0 or the distortion model is not one CameraModel projects.
-std::shared_ptr<const IntensityImage> intensityImage(const cv::Mat& image,
-                                                     const PinholeIntrinsics& intrinsics,
-                                                     int levels);
+// null when levels is 0 or the distortion model is not one CameraModel projects. With `buffers`,
+// the levels are written into buffers taken from it and handed back when the image is destroyed.
+std::shared_ptr<const IntensityImage> intensityImage(
+    const cv::Mat& image, const PinholeIntrinsics& intrinsics, int levels,
+    const std::shared_ptr<FloatBufferPool>& buffers = nullptr);
 
 // Rays (x/z, y/z) through pixel centres (or sub-pixel positions), undistorted when the
 // intrinsics carry distortion.
@@ -87,6 +89,9 @@ class DepthCloudBuilder {
   CloudBuilderOptions options_;
   PointSelector selector_;
   RayTable rays_;
+  // The photometric levels' buffers, reused from frame to frame (shared with the images, which
+  // hand theirs back when destroyed, on whichever thread).
+  std::shared_ptr<FloatBufferPool> level_buffers_;
 };
 
 }  // namespace cvo

@@ -1,0 +1,36 @@
+#include "cvo_odometry/frontend/float_buffer_pool.hpp"
+
+#include <utility>
+
+namespace cvo {
+
+FloatBufferPool::FloatBufferPool(std::size_t max_kept) : max_kept_(max_kept) {
+  kept_.reserve(max_kept_);  // give() then never allocates
+}
+
+std::vector<float> FloatBufferPool::take(std::size_t size) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = kept_.begin(); it != kept_.end(); ++it) {
+      if (it->size() == size) {
+        std::vector<float> buffer = std::move(*it);
+        kept_.erase(it);
+        return buffer;
+      }
+    }
+  }
+  return std::vector<float>(size);
+}
+
+void FloatBufferPool::give(std::vector<float> buffer) noexcept {
+  if (buffer.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (kept_.size() < max_kept_) kept_.push_back(std::move(buffer));
+}
+
+std::size_t FloatBufferPool::kept() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return kept_.size();
+}
+
+}  // namespace cvo
