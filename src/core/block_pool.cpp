@@ -1,6 +1,7 @@
 #include "cvo_odometry/core/block_pool.hpp"
 
 #include <chrono>
+#include <cstdint>
 #include <exception>
 
 namespace cvo {
@@ -8,16 +9,46 @@ namespace cvo {
 struct BlockPool::Loop {
   std::size_t count = 0;
   const std::function<void(std::size_t)>* block = nullptr;  // valid while blocks remain
-  std::atomic<std::size_t> next{0};                         // the next block to claim
-  std::atomic<std::size_t> done{0};                         // blocks finished
-  std::mutex mutex;                                         // guards error, signals the end
+  // Each thread's share of the blocks, a contiguous range [front, back) packed in one word
+  // (front in the high half): its owner claims from the front, a thread done with its own share
+  // takes from the back of another's. The same block count is shared the same way every loop,
+  // so a block runs on the thread that ran it last (its data in that core's cache) unless the
+  // threads fall out of step.
+  int shares = 1;
+  std::unique_ptr<std::atomic<std::uint64_t>[]> ranges;
+  std::atomic<std::size_t> done{0};  // blocks finished
+  std::mutex mutex;                  // guards error, signals the end
   std::condition_variable finished;
   std::exception_ptr error;
 };
 
+namespace {
+
+constexpr std::uint64_t kHalf = 0xffffffffu;
+
+std::uint64_t packRange(std::uint64_t front, std::uint64_t back) {
+  return front << 32 | back;
+}
+
+// Claims the front (or back) block of `range`; false when it is empty.
+bool claim(std::atomic<std::uint64_t>& range, bool from_front, std::size_t* block) {
+  std::uint64_t value = range.load();
+  for (;;) {
+    const std::uint64_t front = value >> 32, back = value & kHalf;
+    if (front >= back) return false;
+    const std::uint64_t next = from_front ? packRange(front + 1, back) : packRange(front, back - 1);
+    if (range.compare_exchange_weak(value, next)) {
+      *block = static_cast<std::size_t>(from_front ? front : back - 1);
+      return true;
+    }
+  }
+}
+
+}  // namespace
+
 BlockPool::BlockPool(int threads) {
   for (int k = 1; k < threads; ++k)
-    helpers_.emplace_back([this] { help(); });
+    helpers_.emplace_back([this, k] { help(k); });
 }
 
 BlockPool::~BlockPool() {
@@ -30,24 +61,34 @@ BlockPool::~BlockPool() {
     helper.join();
 }
 
-void BlockPool::work(Loop& loop) {
-  for (;;) {
-    const std::size_t b = loop.next.fetch_add(1);
-    if (b >= loop.count) return;  // `block` may be gone from here on: not touched again
-    try {
-      (*loop.block)(b);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(loop.mutex);
-      if (!loop.error) loop.error = std::current_exception();
-    }
-    if (loop.done.fetch_add(1) + 1 == loop.count) {
-      std::lock_guard<std::mutex> lock(loop.mutex);
-      loop.finished.notify_all();
-    }
+void BlockPool::runBlock(Loop& loop, std::size_t b) {
+  try {
+    (*loop.block)(b);
+  } catch (...) {
+    std::lock_guard<std::mutex> lock(loop.mutex);
+    if (!loop.error) loop.error = std::current_exception();
+  }
+  if (loop.done.fetch_add(1) + 1 == loop.count) {
+    std::lock_guard<std::mutex> lock(loop.mutex);
+    loop.finished.notify_all();
   }
 }
 
-void BlockPool::help() {
+void BlockPool::work(Loop& loop, int self) {
+  // Once no range holds a block, `block` may be gone: it is not touched again.
+  std::size_t b = 0;
+  if (self < loop.shares) {
+    while (claim(loop.ranges[self], true, &b))
+      runBlock(loop, b);
+  }
+  for (int k = 1; k <= loop.shares; ++k) {
+    const int other = (self + k) % loop.shares;
+    while (claim(loop.ranges[other], false, &b))
+      runBlock(loop, b);
+  }
+}
+
+void BlockPool::help(int self) {
   std::size_t seen = 0;
   for (;;) {
     // Loops come back to back within a registration: look for the next one a little while
@@ -63,17 +104,29 @@ void BlockPool::help() {
       seen = generation_;
       loop = loop_;
     }
-    if (loop) work(*loop);
+    if (loop) work(*loop, self);
   }
 }
 
 void BlockPool::run(std::size_t count, const std::function<void(std::size_t)>& block) {
   if (count == 0) return;
+  if (count > kHalf) {  // more blocks than a range's half word holds: never in practice
+    for (std::size_t b = 0; b < count; ++b)
+      block(b);
+    return;
+  }
   std::lock_guard<std::mutex> serial(run_mutex_);
   auto loop = std::make_shared<Loop>();
   loop->count = count;
   loop->block = &block;
-  if (!helpers_.empty() && count > 1) {
+  const bool shared = !helpers_.empty() && count > 1;
+  loop->shares = shared ? threads() : 1;
+  loop->ranges = std::make_unique<std::atomic<std::uint64_t>[]>(loop->shares);
+  for (int k = 0; k < loop->shares; ++k) {
+    const std::uint64_t front = count * k / loop->shares, back = count * (k + 1) / loop->shares;
+    loop->ranges[k].store(packRange(front, back));
+  }
+  if (shared) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       loop_ = loop;
@@ -81,7 +134,7 @@ void BlockPool::run(std::size_t count, const std::function<void(std::size_t)>& b
     }
     wake_.notify_all();
   }
-  work(*loop);
+  work(*loop, 0);
   // Only blocks a helper has claimed can still be running: wait for those, briefly spinning
   // (they are short), then asleep.
   const auto spin_until = std::chrono::steady_clock::now() + std::chrono::microseconds(50);

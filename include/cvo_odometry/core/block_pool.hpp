@@ -4,8 +4,11 @@
 // claims blocks too, so on cores shared with other processes (a robot's normal state) a
 // descheduled helper costs nothing instead of a time slice at every barrier. Measured before
 // this existed: 2 OpenMP threads under two busy loops took 2x the time of 1 thread (README
-// "Benchmark"). Which thread runs a block does not matter to the results: callers write one
-// result per block and combine them in block order.
+// "Benchmark"). Each thread starts on its own contiguous share of the blocks, the same share
+// every loop of the same size, and takes the rest of another's once its own is done: a block's
+// data (the CPU backend's candidate lists, built in one loop and summed in the next) stays in
+// the cache of the core that wrote it. Which thread runs a block does not matter to the results:
+// callers write one result per block and combine them in block order.
 #pragma once
 
 #include <algorithm>
@@ -37,9 +40,12 @@ class BlockPool {
 
  private:
   struct Loop;
-  void help();
-  // Claims and runs blocks of `loop` until none is left.
-  static void work(Loop& loop);
+  // Helper `self` (1, 2, ...; the caller is 0) waiting for loops and working on them.
+  void help(int self);
+  // Claims and runs blocks of `loop` until none is left: thread `self`'s share first, from its
+  // front, then the others' from their backs.
+  static void work(Loop& loop, int self);
+  static void runBlock(Loop& loop, std::size_t b);
 
   std::mutex run_mutex_;  // one loop at a time
   std::mutex mutex_;
