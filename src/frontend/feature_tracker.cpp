@@ -93,10 +93,15 @@ void FeatureTracker::reset() {
   has_previous_ = false;
 }
 
-std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey) const {
-  std::vector<cv::Mat> levels;
+std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey,
+                                             std::vector<cv::Mat> reuse) const {
+  // OpenCV writes into the buffers that have the right size. Level 0 is always a copy (not the
+  // caller's image, which a view with a wide enough border would be): the caller may reuse its
+  // image, and these buffers are written again two frames on.
+  std::vector<cv::Mat> levels = std::move(reuse);
   cv::buildOpticalFlowPyramid(grey, levels, cv::Size(options_.window, options_.window),
-                              options_.levels);
+                              options_.levels, true, cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT,
+                              false);
   return levels;
 }
 
@@ -132,7 +137,7 @@ MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
 MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
                                          const PinholeIntrinsics& K, int crop_top_rows) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<cv::Mat> current = pyramid(grey);
+  std::vector<cv::Mat> current = pyramid(grey, std::move(spare_pyramid_));
   MotionPrior prior =
       points_.empty() || last_pyramid_.empty() ? MotionPrior{} : solve(current, grey.size(), K);
   if (points_.empty()) {
@@ -143,13 +148,18 @@ MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& dep
   seed_problem_.clear();
   seed_ms_ = 0.0;
   // This frame's corners replace the previous frame's; none if the search cannot even start.
+  // The previous pyramid is no longer read by anyone (the corner search is finished).
+  spare_pyramid_ = std::move(last_pyramid_);
   forgetCorners();
   has_previous_ = true;
-  // Copies: the caller may reuse its buffers once this returns.
-  seeding_ = std::async(std::launch::async, [this, grey = grey.clone(), depth = depth.clone(), K,
-                                             crop_top_rows, levels = std::move(current)]() mutable {
+  // Copies, into the buffers of the last ones (the search for them is finished): the caller may
+  // reuse its images once this returns.
+  grey.copyTo(seed_grey_);
+  depth.copyTo(seed_depth_);
+  seeding_ = std::async(std::launch::async, [this, K, crop_top_rows,
+                                             levels = std::move(current)]() mutable {
     const auto begin = std::chrono::steady_clock::now();
-    seed(grey, depth, K, crop_top_rows, std::move(levels));
+    seed(seed_grey_, seed_depth_, K, crop_top_rows, std::move(levels));
     seed_ms_ =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
   });

@@ -34,7 +34,7 @@ GreyFrame load(const cvo::TumSequence& sequence, std::size_t k) {
 TEST(FeatureTracker, ImagesTheCallerReusesDoNotChangeThePriors) {
   const cvo::TumSequence sequence(kTum);
   const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
-  cvo::FeatureTracker prompt({}), delayed({});
+  cvo::FeatureTracker prompt({}), delayed({}), viewed({});
   for (std::size_t k = 0; k < 6; ++k) {
     const GreyFrame frame = load(sequence, k);
     const cvo::MotionPrior a = prompt.track(frame.grey, frame.depth, K);
@@ -43,6 +43,13 @@ TEST(FeatureTracker, ImagesTheCallerReusesDoNotChangeThePriors) {
     const cvo::MotionPrior b = delayed.track(reused.grey, reused.depth, K);
     reused.grey.setTo(0);
     reused.depth.setTo(0);
+    // A view into a larger image (border wider than the KLT window, which OpenCV's pyramid
+    // would otherwise take as its first level) is copied too.
+    cv::Mat padded;
+    cv::copyMakeBorder(frame.grey, padded, 40, 40, 40, 40, cv::BORDER_REFLECT_101);
+    const cvo::MotionPrior c =
+        viewed.track(padded(cv::Rect(40, 40, frame.grey.cols, frame.grey.rows)), frame.depth, K);
+    padded.setTo(0);
     EXPECT_TRUE(prompt.seeded());  // waits: the next frame has corners to track
     if (k == 0) {
       EXPECT_FALSE(a.solved);
@@ -53,6 +60,9 @@ TEST(FeatureTracker, ImagesTheCallerReusesDoNotChangeThePriors) {
     EXPECT_GT(a.inliers, 100);
     EXPECT_EQ(a.inliers, b.inliers);
     EXPECT_LT((a.motion.matrix() - b.motion.matrix()).norm(), 1e-12) << "frame " << k;
+    ASSERT_TRUE(c.solved) << c.problem;
+    EXPECT_EQ(a.inliers, c.inliers);
+    EXPECT_LT((a.motion.matrix() - c.motion.matrix()).norm(), 1e-12) << "frame " << k;
     EXPECT_GT(a.seed_ms, 0.0);  // the previous frame's corners took time, beside it
   }
 }

@@ -58,7 +58,8 @@ class FeatureTracker {
   void reset();
 
  private:
-  std::vector<cv::Mat> pyramid(const cv::Mat& grey) const;
+  // The KLT pyramid of `grey`, built in the buffers of `reuse` where their sizes fit.
+  std::vector<cv::Mat> pyramid(const cv::Mat& grey, std::vector<cv::Mat> reuse) const;
   // Finds this frame's corners (grey and depth owned by the call), after forgetCorners().
   void seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
             int crop_top_rows, std::vector<cv::Mat> pyramid);
@@ -77,9 +78,13 @@ class FeatureTracker {
   std::vector<cv::Point3f> points_;    // the previous frame's camera frame
   std::vector<cv::Point2f> pixels_;    // where the previous image sees them
   std::vector<cv::Mat> last_pyramid_;  // of the previous image
-  std::future<void> seeding_;          // the previous frame's corners, being found
-  double seed_ms_ = 0.0;               // how long they took
-  std::string seed_problem_;           // why finding them failed
+  // The one before, done with: the next frame's pyramid is built in its buffers (~2 MB a frame
+  // at 640x480, otherwise allocated and first touched anew).
+  std::vector<cv::Mat> spare_pyramid_;
+  std::future<void> seeding_;       // the previous frame's corners, being found
+  cv::Mat seed_grey_, seed_depth_;  // that frame's images, read by the search only
+  double seed_ms_ = 0.0;            // how long they took
+  std::string seed_problem_;        // why finding them failed
   bool has_previous_ = false;
 };
 
