@@ -1,5 +1,6 @@
 #include "cvo_odometry/core/block_pool.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <exception>
@@ -12,10 +13,14 @@ struct BlockPool::Loop {
   // Each thread's share of the blocks, a contiguous range [front, back) packed in one word
   // (front in the high half): its owner claims from the front, a thread done with its own share
   // takes from the back of another's. The same block count is shared the same way every loop,
-  // so a block runs on the thread that ran it last (its data in that core's cache) unless the
-  // threads fall out of step.
+  // so a block usually runs on the thread that ran it last (its data in that core's cache,
+  // while the scheduler keeps the thread there) unless the threads fall out of step.
+  // A cache line each: one thread's claims do not invalidate the line another steals from.
+  struct alignas(64) Share {
+    std::atomic<std::uint64_t> range{0};
+  };
   int shares = 1;
-  std::unique_ptr<std::atomic<std::uint64_t>[]> ranges;
+  std::unique_ptr<Share[]> ranges;
   std::atomic<std::size_t> done{0};  // blocks finished
   std::mutex mutex;                  // guards error, signals the end
   std::condition_variable finished;
@@ -78,12 +83,12 @@ void BlockPool::work(Loop& loop, int self) {
   // Once no range holds a block, `block` may be gone: it is not touched again.
   std::size_t b = 0;
   if (self < loop.shares) {
-    while (claim(loop.ranges[self], true, &b))
+    while (claim(loop.ranges[self].range, true, &b))
       runBlock(loop, b);
   }
   for (int k = 1; k <= loop.shares; ++k) {
     const int other = (self + k) % loop.shares;
-    while (claim(loop.ranges[other], false, &b))
+    while (claim(loop.ranges[other].range, false, &b))
       runBlock(loop, b);
   }
 }
@@ -109,23 +114,36 @@ void BlockPool::help(int self) {
 }
 
 void BlockPool::run(std::size_t count, const std::function<void(std::size_t)>& block) {
-  if (count == 0) return;
-  if (count > kHalf) {  // more blocks than a range's half word holds: never in practice
-    for (std::size_t b = 0; b < count; ++b)
-      block(b);
+  if (count <= kHalf) {
+    runLoop(count, block);
     return;
   }
+  // More blocks than a range's half word holds (never in practice): loops of at most that many,
+  // each finished, the first exception rethrown at the end.
+  std::exception_ptr error;
+  for (std::size_t first = 0; first < count; first += kHalf) {
+    const std::function<void(std::size_t)> part = [&](std::size_t b) { block(first + b); };
+    try {
+      runLoop(std::min<std::size_t>(kHalf, count - first), part);
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+void BlockPool::runLoop(std::size_t count, const std::function<void(std::size_t)>& block) {
+  if (count == 0) return;
   std::lock_guard<std::mutex> serial(run_mutex_);
   auto loop = std::make_shared<Loop>();
   loop->count = count;
   loop->block = &block;
   const bool shared = !helpers_.empty() && count > 1;
   loop->shares = shared ? threads() : 1;
-  loop->ranges = std::make_unique<std::atomic<std::uint64_t>[]>(loop->shares);
-  for (int k = 0; k < loop->shares; ++k) {
-    const std::uint64_t front = count * k / loop->shares, back = count * (k + 1) / loop->shares;
-    loop->ranges[k].store(packRange(front, back));
-  }
+  loop->ranges = std::make_unique<Loop::Share[]>(static_cast<std::size_t>(loop->shares));
+  const std::uint64_t n = count, shares = static_cast<std::uint64_t>(loop->shares);
+  for (std::uint64_t k = 0; k < shares; ++k)
+    loop->ranges[k].range.store(packRange(n * k / shares, n * (k + 1) / shares));
   if (shared) {
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -25,7 +25,11 @@ std::vector<float> FloatBufferPool::take(std::size_t size) {
 void FloatBufferPool::give(std::vector<float> buffer) noexcept {
   if (buffer.empty()) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (kept_.size() < max_kept_) kept_.push_back(std::move(buffer));
+  if (max_kept_ == 0) return;
+  // Full: the buffer kept longest goes (so after the images change size the new size takes
+  // over); the capacity reserved up front means no allocation here.
+  if (kept_.size() == max_kept_) kept_.erase(kept_.begin());
+  kept_.push_back(std::move(buffer));
 }
 
 std::size_t FloatBufferPool::kept() const {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "cvo_odometry/core/block_pool.hpp"
@@ -42,6 +43,32 @@ TEST(BlockPool, ManyShortLoopsBackToBack) {
     expected += std::accumulate(serial.begin(), serial.end(), 0.0);
   }
   EXPECT_EQ(total, expected);  // same additions in the same order
+}
+
+TEST(BlockPool, TheCallerFinishesTheShareOfAHelperHeldUpInABlock) {
+  // A helper holds the first block it gets until every other block has run, as a descheduled
+  // one would: the caller must take the rest of that helper's share (else run() never returns).
+  BlockPool pool(2);
+  const std::thread::id caller = std::this_thread::get_id();
+  int loops_held = 0;
+  for (int loop = 0; loop < 200; ++loop) {
+    constexpr std::size_t kCount = 64;
+    std::atomic<std::size_t> finished{0};
+    std::atomic<bool> held{false};
+    pool.run(kCount, [&](std::size_t) {
+      volatile double work = 0.0;  // long enough for the helper to wake and claim a block
+      for (int i = 0; i < 2000; ++i)
+        work = work + i;
+      if (std::this_thread::get_id() != caller && !held.exchange(true)) {
+        while (finished.load() + 1 < kCount)
+          std::this_thread::yield();
+      }
+      ++finished;
+    });
+    ASSERT_EQ(finished.load(), kCount);
+    loops_held += held.load() ? 1 : 0;
+  }
+  RecordProperty("loops_with_a_held_helper", loops_held);
 }
 
 TEST(BlockPool, AnExceptionComesOutAfterTheOtherBlocks) {

@@ -23,17 +23,32 @@ TEST(FloatBufferPool, HandsBackTheBufferKeptForThatSize) {
   a[7] = 3.0f;
   const float* storage = a.data();
   pool.give(std::move(a));
-  pool.give(std::vector<float>(50, 1.0f));
-  pool.give(std::vector<float>(60, 1.0f));  // beyond max_kept: freed
-  pool.give({});                            // nothing to keep
-  EXPECT_EQ(pool.kept(), 2u);
+  pool.give({});  // nothing to keep
+  EXPECT_EQ(pool.kept(), 1u);
   const std::vector<float> other = pool.take(70);  // no kept buffer of 70: a new one
   EXPECT_EQ(other.size(), 70u);
-  EXPECT_EQ(pool.kept(), 2u);
+  EXPECT_EQ(pool.kept(), 1u);
   const std::vector<float> again = pool.take(100);
   EXPECT_EQ(again.data(), storage);
   EXPECT_EQ(again[7], 3.0f) << "a kept buffer holds what its last user left";
-  EXPECT_EQ(pool.kept(), 1u);
+  EXPECT_EQ(pool.kept(), 0u);
+}
+
+TEST(FloatBufferPool, WhenFullTheBufferKeptLongestGoes) {
+  // The images changed size: a pool full of the old size comes to serve the new one.
+  cvo::FloatBufferPool pool(2);
+  pool.give(std::vector<float>(100));
+  pool.give(std::vector<float>(100));
+  std::vector<float> first(200), second(200);
+  const float* first_storage = first.data();
+  const float* second_storage = second.data();
+  pool.give(std::move(first));
+  pool.give(std::move(second));
+  EXPECT_EQ(pool.kept(), 2u);
+  const std::vector<float> a = pool.take(200), b = pool.take(200);
+  EXPECT_EQ(a.data(), first_storage);
+  EXPECT_EQ(b.data(), second_storage);
+  EXPECT_EQ(pool.kept(), 0u) << "both buffers of 100 went";
 }
 
 TEST(FloatBufferPool, LevelsBuiltInReusedBuffersEqualFreshOnes) {

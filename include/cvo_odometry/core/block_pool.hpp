@@ -6,9 +6,10 @@
 // this existed: 2 OpenMP threads under two busy loops took 2x the time of 1 thread (README
 // "Benchmark"). Each thread starts on its own contiguous share of the blocks, the same share
 // every loop of the same size, and takes the rest of another's once its own is done: a block's
-// data (the CPU backend's candidate lists, built in one loop and summed in the next) stays in
-// the cache of the core that wrote it. Which thread runs a block does not matter to the results:
-// callers write one result per block and combine them in block order.
+// data (the CPU backend's candidate lists, built in one loop and summed in the next) usually
+// stays in the cache of the core that wrote it (threads are not pinned). Which thread runs a block
+// does not matter to the results: callers write one result per block and combine them in block
+// order.
 #pragma once
 
 #include <algorithm>
@@ -45,6 +46,8 @@ class BlockPool {
   // Claims and runs blocks of `loop` until none is left: thread `self`'s share first, from its
   // front, then the others' from their backs.
   static void work(Loop& loop, int self);
+  // run() for at most 2^32 - 1 blocks (a share's range is two 32-bit halves).
+  void runLoop(std::size_t count, const std::function<void(std::size_t)>& block);
   static void runBlock(Loop& loop, std::size_t b);
 
   std::mutex run_mutex_;  // one loop at a time

@@ -31,7 +31,8 @@ class GridCache {
   struct Entry {
     VoxelGrid grid;
     std::vector<float> positions;  // what grid was built from
-    float cell_size = -1.0f;       // -1: empty
+    float cell_size = 0.0f;
+    bool valid = false;  // false while empty or after a build that threw
     std::uint64_t last_used = 0;
   };
   static bool holds(const Entry& entry, const float* positions, std::size_t count, float cell_size);

@@ -60,12 +60,13 @@ class FeatureTracker {
  private:
   // The KLT pyramid of `grey`, built in the buffers of `reuse` where their sizes fit.
   std::vector<cv::Mat> pyramid(const cv::Mat& grey, std::vector<cv::Mat> reuse) const;
-  // Finds this frame's corners (grey and depth owned by the call), after forgetCorners().
+  // Finds this frame's corners in seed_grey_ and seed_depth_ (written again only after
+  // finishSeeding()), after forgetCorners().
   void seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
             int crop_top_rows, std::vector<cv::Mat> pyramid);
   // Waits for the corners being found, if any; a failure there leaves none, and says why.
   void finishSeeding();
-  // Drops the corners and the image they were found in: nothing to track from.
+  // Drops the corners and the pyramid they were found in: nothing to track from.
   void forgetCorners();
   // track() after the wait: the prior, then this frame's corners started on their thread.
   MotionPrior trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,

@@ -12,14 +12,15 @@ namespace cvo {
 
 class FloatBufferPool {
  public:
-  // Keeps at most `max_kept` handed-back buffers (the rest are freed).
+  // Keeps at most `max_kept` handed-back buffers.
   explicit FloatBufferPool(std::size_t max_kept);
 
   // A buffer of `size` floats: a kept one of that size when there is one (its values are what
   // its last user left), else a new one (zeros).
   std::vector<float> take(std::size_t size);
-  // Keeps `buffer` for a later take() while fewer than max_kept are kept. Does not throw (an
-  // image's deleter calls it).
+  // Keeps `buffer` for a later take(), in place of the buffer kept longest when max_kept are
+  // kept (after the images change size, the new size takes over). Allocates nothing (it runs in
+  // an image's deleter); a mutex that fails to lock terminates.
   void give(std::vector<float> buffer) noexcept;
 
   std::size_t kept() const;
