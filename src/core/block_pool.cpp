@@ -80,15 +80,14 @@ void BlockPool::runBlock(Loop& loop, std::size_t b) {
 }
 
 void BlockPool::work(Loop& loop, int self) {
-  // Once no range holds a block, `block` may be gone: it is not touched again.
+  // self < loop.shares: a loop of one share is never published to the helpers, and a published
+  // one has a share for every thread. Once no range holds a block, `block` may be gone: it is
+  // not touched again.
   std::size_t b = 0;
-  if (self < loop.shares) {
-    while (claim(loop.ranges[self].range, true, &b))
-      runBlock(loop, b);
-  }
-  for (int k = 1; k <= loop.shares; ++k) {
-    const int other = (self + k) % loop.shares;
-    while (claim(loop.ranges[other].range, false, &b))
+  while (claim(loop.ranges[self].range, true, &b))
+    runBlock(loop, b);
+  for (int k = 1; k < loop.shares; ++k) {
+    while (claim(loop.ranges[(self + k) % loop.shares].range, false, &b))
       runBlock(loop, b);
   }
 }
