@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -108,13 +109,19 @@ int main(int argc, char** argv) {
     std::optional<cvo::DisparityOffsetEstimate> offset_estimate;  // stereo self-calibration
     std::optional<std::size_t> offset_changed_at;  // the first frame built with another offset
     double offset_in_use = settings.disparity_offset;
+    // The process's CPU time (all its threads) against the wall time of the frames' `total`:
+    // how many cores the run got. Under load it tells where the scheduler put the run (README
+    // "Benchmark": about 1 with a core to itself, about 0.55 when sharing one with a busy loop).
+    double cpu_ms_sum = 0.0, total_ms_sum = 0.0;
     for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
       timer.add("decode", std::chrono::duration<double, std::milli>(
                               std::chrono::steady_clock::now() - decode_start)
                               .count());
+      const std::clock_t cpu_start = std::clock();
       const cvo::PipelineResult result = pipeline.process(input.stamps[k], frame);
+      const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
       const cvo::OdometryUpdate& update = result.update;
       tally.add(result);
       if (result.outcome == cvo::FrameOutcome::kProcessed) {
@@ -144,6 +151,9 @@ int main(int argc, char** argv) {
           timer.add("registration", update.report.time_ms);
           if (update.photometric.applied) timer.add("photometric", update.photometric.time_ms);
           timer.add("total", result.total_ms);
+          timer.add("cpu (all threads)", cpu_ms);
+          cpu_ms_sum += cpu_ms;
+          total_ms_sum += result.total_ms;
         }
       }
       const std::size_t done = (k - first) / stride + 1;
@@ -212,6 +222,10 @@ int main(int argc, char** argv) {
       }
     }
     timer.print(std::cout);
+    if (total_ms_sum > 0.0) {
+      std::cout << std::setprecision(2) << "cores in use: " << cpu_ms_sum / total_ms_sum
+                << " (the process's CPU time over the wall time of its frames' total)\n";
+    }
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))
                                             : input.trajectory_format;
