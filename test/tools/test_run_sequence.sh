@@ -22,6 +22,9 @@ awk -v t="$t" 'BEGIN { exit !(t < 0.00360) }' || fail "TUM RPE $t m, bound 0.003
 awk -v r="$r" 'BEGIN { exit !(r < 0.348) }' || fail "TUM RPE $r deg, bound 0.348"
 [ "$(grep -vc '^#' "$work/tum.txt")" = 37 ] || fail "TUM trajectory should have 37 poses"
 [ -s "$work/tum.png" ] || fail "no plot written"
+# The cores a run got (bench/load_time.sh reads them): some CPU time is always spent.
+cores=$(awk '/^cores in use:/ { print $4 }' "$work/tum_report.txt")
+awk -v c="$cores" 'BEGIN { exit !(c > 0) }' || fail "no 'cores in use' figure: '$cores'"
 
 kitti="$root/test/data/kitti_06_stereo"
 "$runner" --kitti "$kitti" --preset "$root/config/kitti_stereo.yaml" --backend cpu --quiet \
