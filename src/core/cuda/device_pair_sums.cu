@@ -6,8 +6,15 @@
 // differs by system (execution policy, staging, the OpenMP reduction) is in cuda_system.cuh and
 // omp_system.hpp.
 //
+// Parallelism: each source point's candidates are split between kLanesPerPoint lanes, lane l
+// taking every kLanesPerPoint-th candidate of the point's stream of grid ranges from the l-th:
+// on a GPU a warp then works on one point, its lanes reading consecutive target points (one
+// thread a point left 15k threads each walking ~400 candidates in a row, latency-bound). A point's
+// sums are linear in its pairs' (moments, Taylor terms, curvature), so the lanes' shares add up.
+//
 // Determinism: the grid is a stable sort (a unique order); each evaluation is one
-// transform_reduce over the source points, whose order of additions is fixed for a given size:
+// transform_reduce over the (source point, lane) items, whose order of additions is fixed for a
+// given size:
 // on CUDA by CUB's reduction (run to run on a device), on OpenMP by fixed chunks added in order
 // (omp_system.hpp: the same bits for any thread count).
 #include <thrust/binary_search.h>
@@ -63,6 +70,7 @@ struct PairContext {
   CloudView target, source;
   kernels::DenseGridShape shape;
   const unsigned* start;  // first sorted point of every cell, then the point count
+  int lanes;              // items a source point's candidates are split between
   float radius;           // the query radius: the cut-off at this lengthscale (<= the cell edge)
   float reach2;           // radius^2 and a margin: no pair beyond it can be retained
   Pose3x4 pose;
@@ -75,15 +83,23 @@ struct PairContext {
     kernels::transformPoint(pose.m, source.positions + 3 * j, z);
   }
 
-  // f(x, a) for the candidate target points x of source point j (at z) that may be retained,
-  // with the pair's retained weight a (0 when not retained), in the grid's fixed order. The
-  // ranges also hold points beyond the ball (weight 0, which adds nothing to any sum): those are
-  // skipped before their appearance is computed.
+  // f(x, a) for lane `lane`'s share of the candidate target points x of source point j (at z)
+  // that may be retained, with the pair's retained weight a (0 when not retained), in the grid's
+  // fixed order: candidates lane, lane + lanes, ... of the point's ranges taken as one stream.
+  // The ranges also hold points beyond the ball (weight 0, which adds nothing to any sum): those
+  // are skipped before their appearance is computed.
   template <class F>
-  CVO_HOST_DEVICE void forEachPair(int j, const float* z, F&& f) const {
+  CVO_HOST_DEVICE void forEachPair(int j, int lane, const float* z, F&& f) const {
     const bool appearance = k.use_color || k.semantic_classes > 0;
+    const auto step = static_cast<unsigned>(lanes);
+    unsigned skip = static_cast<unsigned>(lane);  // candidates before this lane's next one
     kernels::forEachRangeWithin(shape, start, z, radius, [&](unsigned begin, unsigned end) {
-      for (unsigned i = begin; i < end; ++i) {
+      if (end - begin <= skip) {
+        skip -= end - begin;
+        return;
+      }
+      unsigned i = begin + skip;
+      for (; i < end; i += step) {
         const float* x = target.positions + 3 * i;
         const float dx = x[0] - z[0], dy = x[1] - z[1], dz = x[2] - z[2];
         if (dx * dx + dy * dy + dz * dz > reach2) continue;
@@ -99,50 +115,52 @@ struct PairContext {
                 : k.max_weight;  // = appearanceWeight(k, 0)
         f(x, kernels::retainedPairWeight(weight, dx, dy, dz, inv_two_ell2, k.sp_thres));
       }
+      skip = i - end;
     });
   }
 
-  // Adds source point j's (at z) share of the moments over its candidates to m.
-  CVO_HOST_DEVICE void addMoments(int j, const float* z, kernels::MomentSums& m) const {
+  // Adds lane `lane`'s share of source point j's (at z) moments over its candidates to m.
+  CVO_HOST_DEVICE void addMoments(int j, int lane, const float* z, kernels::MomentSums& m) const {
     kernels::PointSums sums;
     kernels::clear(sums);
-    forEachPair(j, z, [&](const float* x, float a) {
+    forEachPair(j, lane, z, [&](const float* x, float a) {
       kernels::accumulatePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2]);
     });
     if (sums.pairs > 0) kernels::accumulatePoint(m, sums, z);
   }
 };
 
-// Source point j's share of an evaluation's sums: the point moved by the pose, then
-// add(context, j, z, sums) over its candidates.
+// Item `item`'s share of an evaluation's sums: source point j = item / lanes moved by the pose,
+// then add(context, j, lane, z, sums) over that lane's candidates.
 template <class Sums, class Add>
 struct ShareOfPoint {
   PairContext c;
   Add add;
-  CVO_HOST_DEVICE Sums operator()(int j) const {
+  CVO_HOST_DEVICE Sums operator()(int item) const {
+    const int j = item / c.lanes, lane = item % c.lanes;
     Sums sums;
     kernels::clear(sums);
     float z[3];
     c.moved(j, z);
-    add(c, j, z, sums);
+    add(c, j, lane, z, sums);
     return sums;
   }
 };
 
 struct AddMoments {
-  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, int lane, const float* z,
                                   kernels::MomentSums& m) const {
-    c.addMoments(j, z, m);
+    c.addMoments(j, lane, z, m);
   }
 };
 
 struct AddTaylor {
   Twist xi;
-  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, int lane, const float* z,
                                   kernels::TaylorSums& s) const {
     kernels::TaylorFrame frame;
     kernels::makeTaylorFrame(z, xi.v, frame);
-    c.forEachPair(j, z, [&](const float* x, float a) {
+    c.forEachPair(j, lane, z, [&](const float* x, float a) {
       if (a > 0.0f) kernels::accumulateTaylorPair(s, frame, x, z, a, c.inv_ell2);
     });
   }
@@ -150,16 +168,16 @@ struct AddTaylor {
 
 // Moments over every source point, the Hessian from every kCurvatureStride-th (as the CPU).
 struct AddCurvature {
-  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, const float* z,
+  CVO_HOST_DEVICE void operator()(const PairContext& c, int j, int lane, const float* z,
                                   kernels::CurvatureSums& out) const {
     if (j % kernels::kCurvatureStride != 0) {
-      c.addMoments(j, z, out.moments);
+      c.addMoments(j, lane, z, out.moments);
       return;
     }
     kernels::PointCurvature sums;
     kernels::clear(sums);
     const float inv_shell_width = kernels::inverseShellWidth(c.k.sp_thres);
-    c.forEachPair(j, z, [&](const float* x, float a) {
+    c.forEachPair(j, lane, z, [&](const float* x, float a) {
       kernels::accumulateCurvaturePair(sums, a, x[0] - z[0], x[1] - z[1], x[2] - z[2], c.k.sp_thres,
                                        inv_shell_width);
     });
@@ -289,6 +307,7 @@ struct DevicePairSums<System>::Impl {
     c.source = {rawPointer(uploaded[1][0]), rawPointer(uploaded[1][1]), rawPointer(uploaded[1][2])};
     c.shape = shape;
     c.start = rawPointer(start);
+    c.lanes = device::kLanesPerPoint;
     c.radius = static_cast<float>(radius);
     // Beyond reach2 a pair's weight is below sp_thres by a factor exp(-0.001) at least: far
     // more than rounding, so the skipped pairs are never retained ones.
@@ -300,14 +319,15 @@ struct DevicePairSums<System>::Impl {
     return c;
   }
 
-  // One transform_reduce over the source points, `add` giving each point's share at (pose,
-  // ell); one wait, for the result.
+  // One transform_reduce over the (source point, lane) items, `add` giving each one's share at
+  // (pose, ell); one wait, for the result.
   template <class Sums, class Add>
   Sums sumOverSource(const float* pose, double ell, const Add& add) {
     Sums zero;
     kernels::clear(zero);
     const thrust::counting_iterator<int> points(0);
-    return thrust::transform_reduce(runtime.policy(), points, points + count[1],
+    const int items = count[1] * device::kLanesPerPoint;
+    return thrust::transform_reduce(runtime.policy(), points, points + items,
                                     ShareOfPoint<Sums, Add>{context(pose, ell), add}, zero,
                                     AddSums<Sums>{});
   }
