@@ -4,10 +4,13 @@
 // (cpu, cuda, device_cpu: the CUDA backend's code on CPU threads), then the GPU target: at most
 // 2 ms per registration at 15k points with colour (procrustes) on an H100/H200-class GPU, and at
 // least 10x the CPU backend on the same machine. Needs only the core (no ROS/OpenCV).
+// --time-calls adds a line per row: the backend's calls per registration and their time, and the
+// rest of the registration (its own steps between calls).
 #include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -15,6 +18,7 @@
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/params_io.hpp"
+#include "cvo_odometry/core/timed_backend.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
 
 namespace {
@@ -32,6 +36,8 @@ const char* kUsage =
     "  --max-source-points N the registration's source budget (0, the default here: every point,\n"
     "                        so that a row's size is what it sums over)\n"
     "  --reference-max-size N  skip the reference method above this size (3000)\n"
+    "  --time-calls          after each row, the backend's calls per registration, their ms,\n"
+    "                        and the rest of the registration's ms\n"
     "  --check-cuda          only say whether a CUDA device is usable (exit 0, else 3)\n";
 
 // The GPU target (README "Benchmark"): 15k points, colour, the default method.
@@ -52,6 +58,21 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// "#   calls: moments 19 x 0.012 ms, ...; rest 0.41 ms" per registration, over `registrations`.
+void printCallTimes(const cvo::TimedBackend& timed, int registrations, double total_ms) {
+  std::cout << "#   per registration:";
+  for (int call = 0; call < cvo::TimedBackend::kCallKinds; ++call) {
+    const auto kind = static_cast<cvo::TimedBackend::Call>(call);
+    const cvo::TimedBackend::Tally& tally = timed.tally(kind);
+    if (tally.calls == 0) continue;
+    std::cout << " " << cvo::TimedBackend::callName(kind) << " " << std::setprecision(1)
+              << static_cast<double>(tally.calls) / registrations << " x " << std::setprecision(3)
+              << tally.ms / tally.calls << " ms,";
+  }
+  std::cout << " rest " << std::setprecision(3) << (total_ms - timed.totalMs()) / registrations
+            << " ms\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,7 +80,7 @@ int main(int argc, char** argv) {
     const cvo::CommandLine cli(argc, argv,
                                {"data", "sizes", "methods", "kernels", "backends", "repeat",
                                 "max-source-points", "threads", "preset", "reference-max-size"},
-                               {"help", "check-cuda"});
+                               {"help", "check-cuda", "time-calls"});
     if (cli.has("help")) {
       std::cout << kUsage;
       return 0;
@@ -82,6 +103,7 @@ int main(int argc, char** argv) {
       base = cvo::loadCvoParams(cli.get("preset"), base, cvo::UnknownKeys::kIgnore);
     base.num_threads = cli.getInt("threads", 0);
     base.max_source_points = cli.getInt("max-source-points", 0);
+    const bool time_calls = cli.has("time-calls");
     std::string default_backends = "cpu";
     if (cuda) {
       default_backends += ",cuda";
@@ -107,10 +129,19 @@ int main(int argc, char** argv) {
             params.step_method = cvo::parseStepMethod(method);
             params.use_color = kernels == "color";
             params.backend = cvo::parseBackendChoice(backend);
-            cvo::CvoRegistration registration(params);
+            std::unique_ptr<cvo::RegistrationBackend> backend_given;  // null: the registration's
+            cvo::TimedBackend* timed = nullptr;
+            if (time_calls) {
+              auto wrapper = std::make_unique<cvo::TimedBackend>(
+                  cvo::makeBackend(params.backend, params.num_threads));
+              timed = wrapper.get();
+              backend_given = std::move(wrapper);
+            }
+            cvo::CvoRegistration registration(params, std::move(backend_given));
             std::vector<double> ms;
             cvo::RegistrationReport report;
             registration.align(target, source, Eigen::Isometry3d::Identity());  // warm-up
+            if (timed) timed->reset();
             for (int r = 0; r < repeat; ++r) {
               report = registration.align(target, source, Eigen::Isometry3d::Identity()).report;
               ms.push_back(report.time_ms);
@@ -124,6 +155,12 @@ int main(int argc, char** argv) {
                       << std::fixed << std::setprecision(2) << std::setw(11) << median_ms
                       << std::setw(8) << report.iterations << std::setw(14) << std::setprecision(0)
                       << report.mean_pairs << std::setw(9) << speedup << "\n";
+            if (timed) {
+              double total_ms = 0.0;
+              for (const double m : ms)
+                total_ms += m;
+              printCallTimes(*timed, repeat, total_ms);
+            }
             if (size == "15000" && method == "procrustes" && kernels == "color") {
               if (backend == "cpu") target_cpu_ms = median_ms;
               if (backend == "cuda") target_gpu_ms = median_ms;

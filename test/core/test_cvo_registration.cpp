@@ -15,6 +15,7 @@
 #include "cvo_odometry/core/fault_injection_backend.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/pair_kernels.hpp"
+#include "cvo_odometry/core/timed_backend.hpp"
 #include "synthetic_scene.hpp"
 
 using cvo::CvoParams;
@@ -499,6 +500,36 @@ TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
   // order of the sums, and with it, at the margin, a Newton step taken or not: the same answer
   // within the convergence tolerance, not to the bit (1.1e-6 apart under clang's codegen).
   EXPECT_LT((got.transform.matrix() - expected.transform.matrix()).norm(), params.eps_2);
+}
+
+TEST(CvoRegistration, ATimedBackendGivesTheSameAnswerAndCountsEveryCall) {
+  // The benchmark's --time-calls wraps the backend: the registration must not notice, and the
+  // tally must hold every call it made (coarse levels on subsampled clouds, a curvature pass).
+  CvoParams params = syntheticParams(true);
+  const LabeledCloud target = cvo_test::roomScene(2000, 80);
+  const LabeledCloud source = cvo_test::roomScene(2000, 81).transformed(
+      pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
+  CvoRegistration plain(params, std::make_unique<cvo::CpuBackend>(1));
+  auto wrapper = std::make_unique<cvo::TimedBackend>(std::make_unique<cvo::CpuBackend>(1));
+  const cvo::TimedBackend& timed = *wrapper;
+  CvoRegistration wrapped(params, std::move(wrapper));
+  const auto expected = plain.align(target, source, Eigen::Isometry3d::Identity(), true);
+  const auto got = wrapped.align(target, source, Eigen::Isometry3d::Identity(), true);
+  EXPECT_TRUE(got.transform.matrix() == expected.transform.matrix());
+  EXPECT_EQ(got.report.iterations, expected.report.iterations);
+  EXPECT_EQ(got.report.backend, "cpu");
+  using Call = cvo::TimedBackend::Call;
+  // Every iteration sums moments (or a curvature pass that includes them), plus the indicator
+  // at the result.
+  EXPECT_EQ(timed.tally(Call::kMoments).calls + timed.tally(Call::kCurvature).calls,
+            got.report.iterations + 1);
+  EXPECT_GE(timed.tally(Call::kSetProblem).calls, 2);  // a subsampled level, then the finest
+  EXPECT_EQ(timed.tally(Call::kTaylor).calls, 0);      // procrustes steps
+  double sum = 0.0;
+  for (int call = 0; call < cvo::TimedBackend::kCallKinds; ++call)
+    sum += timed.tally(static_cast<Call>(call)).ms;
+  EXPECT_DOUBLE_EQ(timed.totalMs(), sum);
+  EXPECT_LE(timed.totalMs(), got.report.time_ms);
 }
 
 TEST(CvoRegistration, AutoBackendSaysWhyItRunsOnTheCpu) {
