@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -60,29 +62,66 @@ LabeledCloud LabeledCloud::withDepths(const std::function<float(float)>& new_dep
   return out;
 }
 
-LabeledCloud LabeledCloud::picked(std::size_t count,
-                                  const std::function<std::size_t(std::size_t)>& index) const {
-  LabeledCloud out(has_color_, semantic_classes_);
-  out.reserve(count);
+template <class Index>
+void LabeledCloud::pickInto(std::size_t count, Index index, LabeledCloud& out) const {
+  const auto sem = static_cast<std::size_t>(semantic_classes_);
+  out.has_color_ = has_color_;
+  out.semantic_classes_ = semantic_classes_;
+  out.image_.reset();
+  // resize() keeps the capacity: no allocation (or page faults) once the sizes have been seen.
+  out.positions_.resize(3 * count);
+  out.colors_.resize(has_color_ ? kColorDim * count : 0);
+  out.semantics_.resize(sem * count);
   for (std::size_t k = 0; k < count; ++k) {
     const std::size_t i = index(k);
-    out.add(position(i), has_color_ ? color(i) : nullptr,
-            semantic_classes_ ? semantics(i) : nullptr);
+    std::copy_n(&positions_[3 * i], 3, &out.positions_[3 * k]);
+    if (has_color_) std::copy_n(&colors_[kColorDim * i], kColorDim, &out.colors_[kColorDim * k]);
+    if (sem > 0) std::copy_n(&semantics_[sem * i], sem, &out.semantics_[sem * k]);
   }
-  return out;
+}
+
+void LabeledCloud::stridedInto(std::size_t stride, LabeledCloud& out) const {
+  stride = std::max<std::size_t>(stride, 1);
+  pickInto((size() + stride - 1) / stride, [&](std::size_t k) { return k * stride; }, out);
 }
 
 LabeledCloud LabeledCloud::strided(std::size_t stride) const {
-  stride = std::max<std::size_t>(stride, 1);
-  return picked((size() + stride - 1) / stride, [&](std::size_t k) { return k * stride; });
+  LabeledCloud out;
+  stridedInto(stride, out);
+  return out;
+}
+
+void LabeledCloud::thinnedInto(std::size_t count, LabeledCloud& out) const {
+  count = std::min(count, size());
+  pickInto(
+      count, [&](std::size_t k) { return k * size() / count; }, out);
 }
 
 LabeledCloud LabeledCloud::thinned(std::size_t count) const {
   if (count >= size()) return *this;
-  return picked(count, [&](std::size_t k) { return k * size() / count; });
+  LabeledCloud out;
+  thinnedInto(count, out);
+  return out;
 }
 
+namespace {
+
+// True when no value is NaN or infinite: the exponent bits of each, in a loop without an early
+// exit that the compiler vectorises (the scan by point costs 0.25 ms at 15k points).
+bool allFinite(const std::vector<float>& values) {
+  std::uint32_t non_finite = 0;
+  for (const float value : values) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    non_finite |= (bits & 0x7f800000u) == 0x7f800000u;
+  }
+  return non_finite == 0;
+}
+
+}  // namespace
+
 long LabeledCloud::firstNonFinite() const {
+  if (allFinite(positions_) && allFinite(colors_) && allFinite(semantics_)) return -1;
   const std::size_t sem = static_cast<std::size_t>(semantic_classes_);
   for (std::size_t i = 0; i < size(); ++i) {
     bool finite = std::isfinite(positions_[3 * i]) && std::isfinite(positions_[3 * i + 1]) &&

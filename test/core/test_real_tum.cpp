@@ -156,6 +156,36 @@ TEST(RealTum, ThinnedCloudSpreadsItsPointsEvenly) {
   EXPECT_EQ(cloud.thinned(cloud.size() + 5).size(), cloud.size());
 }
 
+// The registration's coarse levels reuse one cloud's storage from level to level and frame to
+// frame: each refill must hold exactly the points and features of a fresh copy, whatever it held.
+TEST(RealTum, CloudsRefilledInPlaceEqualFreshCopies) {
+  const auto cloud = cvo::readCloud(kData + "/tum_clouds/frame10_3000.cloud");
+  ASSERT_TRUE(cloud.hasColor());
+  const auto same = [](const cvo::LabeledCloud& a, const cvo::LabeledCloud& b) {
+    return a.positionData() == b.positionData() && a.colorData() == b.colorData() &&
+           a.semanticData() == b.semanticData() && a.hasColor() == b.hasColor() &&
+           a.semanticClasses() == b.semanticClasses();
+  };
+  cvo::LabeledCloud reused;
+  for (const std::size_t stride : {5, 2, 7, 1, 3}) {
+    cloud.stridedInto(stride, reused);
+    EXPECT_TRUE(same(reused, cloud.strided(stride))) << "stride " << stride;
+    EXPECT_EQ(reused.size(), (cloud.size() + stride - 1) / stride);
+  }
+  for (const std::size_t count : {700, 2500, 10, 1000}) {
+    cloud.thinnedInto(count, reused);
+    EXPECT_TRUE(same(reused, cloud.thinned(count))) << "count " << count;
+  }
+  // A cloud without colour into storage that held colour.
+  cvo::LabeledCloud grey(false);
+  for (std::size_t i = 0; i < 20; ++i)
+    grey.add(cloud.position(i));
+  grey.stridedInto(3, reused);
+  EXPECT_FALSE(reused.hasColor());
+  EXPECT_TRUE(reused.colorData().empty());
+  EXPECT_EQ(reused.size(), 7u);
+}
+
 // A new depth for every point (a stereo rig's disparity offset changed): each point stays on its
 // ray (the same pixel), its features and the image kept; points left without a depth dropped.
 TEST(RealTum, CloudWithNewDepthsKeepsEachPointOnItsRay) {

@@ -67,16 +67,20 @@ class LabeledCloud {
   LabeledCloud withDepths(const std::function<float(float)>& new_depth) const;
   // Every `stride`-th point, starting with the first.
   LabeledCloud strided(std::size_t stride) const;
+  // The same into `out`, reusing its storage (a registration's coarse levels, every frame).
+  void stridedInto(std::size_t stride, LabeledCloud& out) const;
   // `count` points spread evenly over the cloud's order (point floor(k size / count), the first
   // among them); the whole cloud when it has no more.
   LabeledCloud thinned(std::size_t count) const;
+  void thinnedInto(std::size_t count, LabeledCloud& out) const;
   // Index of the first point with a non-finite position or feature, or -1.
   long firstNonFinite() const;
 
  private:
-  // The `count` points index(0), index(1), ... (features too; no image).
-  LabeledCloud picked(std::size_t count,
-                      const std::function<std::size_t(std::size_t)>& index) const;
+  // The `count` points index(0), index(1), ... (features too; no image) into `out`, whose
+  // storage is reused.
+  template <class Index>
+  void pickInto(std::size_t count, Index index, LabeledCloud& out) const;
 
   bool has_color_ = false;
   int semantic_classes_ = 0;
