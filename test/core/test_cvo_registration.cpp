@@ -43,6 +43,16 @@ Eigen::Isometry3d pose(double rx, double ry, double rz, double tx, double ty, do
   return cvo::lie::fromXyzRpy(tx, ty, tz, rx, ry, rz);
 }
 
+// Two 2000-point room scenes (seeds `seed` and seed + 1), the second moved 0.06 m / 2 deg.
+struct RoomPair {
+  LabeledCloud target, source;
+};
+RoomPair movedRoomPair(unsigned seed) {
+  return {cvo_test::roomScene(2000, seed),
+          cvo_test::roomScene(2000, seed + 1)
+              .transformed(pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>())};
+}
+
 double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.inverse() * b).translation().norm();
 }
@@ -368,9 +378,7 @@ INSTANTIATE_TEST_SUITE_P(GeometryAndColour, CpuBackendLists, ::testing::Values(f
 
 TEST(CvoRegistration, ResultsAreIdenticalRunToRunAndAcrossThreadCounts) {
   CvoParams params = syntheticParams(true);
-  const LabeledCloud target = cvo_test::roomScene(2000, 40);
-  const LabeledCloud source = cvo_test::roomScene(2000, 41).transformed(
-      pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
+  const auto [target, source] = movedRoomPair(40);
   CvoRegistration one(params, std::make_unique<cvo::CpuBackend>(1));
   CvoRegistration two(params, std::make_unique<cvo::CpuBackend>(2));
   const auto a = one.align(target, source, Eigen::Isometry3d::Identity(), true);
@@ -483,9 +491,7 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
 
 TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
   CvoParams params = syntheticParams(true);
-  const LabeledCloud target = cvo_test::roomScene(2000, 80);
-  const LabeledCloud source = cvo_test::roomScene(2000, 81).transformed(
-      pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
+  const auto [target, source] = movedRoomPair(80);
   CvoRegistration plain(params, std::make_unique<cvo::CpuBackend>(1));
   CvoRegistration flaky(
       params, std::make_unique<cvo::FailoverBackend>(std::make_unique<cvo::FaultInjectionBackend>(
@@ -506,9 +512,7 @@ TEST(CvoRegistration, ATimedBackendGivesTheSameAnswerAndCountsEveryCall) {
   // The benchmark's --time-calls wraps the backend: the registration must not notice, and the
   // tally must hold every call it made (coarse levels on subsampled clouds, a curvature pass).
   CvoParams params = syntheticParams(true);
-  const LabeledCloud target = cvo_test::roomScene(2000, 80);
-  const LabeledCloud source = cvo_test::roomScene(2000, 81).transformed(
-      pose(0.02, 0.03, -0.01, 0.05, 0.02, 0.01).cast<float>());
+  const auto [target, source] = movedRoomPair(80);
   CvoRegistration plain(params, std::make_unique<cvo::CpuBackend>(1));
   auto wrapper = std::make_unique<cvo::TimedBackend>(std::make_unique<cvo::CpuBackend>(1));
   const cvo::TimedBackend& timed = *wrapper;
