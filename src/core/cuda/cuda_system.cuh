@@ -16,8 +16,6 @@ namespace device {
 
 constexpr DeviceSystem kSystem = DeviceSystem::kCuda;
 constexpr const char* kSystemName = "CUDA";
-// A warp a source point (device_pair_sums.cu).
-constexpr int kLanesPerPoint = 32;
 
 // Throws std::runtime_error naming `what` when status is an error.
 void check(cudaError_t status, const char* what);

@@ -58,6 +58,11 @@ struct Twist {
   double v[6];
 };
 
+// Lanes a source point's candidates are split between (a warp on the GPU), the same on both
+// systems so that device_cpu runs the GPU's arithmetic; a constant, so that item / lanes is a
+// shift.
+constexpr int kLanesPerPoint = 32;
+
 struct CloudView {
   const float* positions;
   const float* colors;     // unused without colour
@@ -70,7 +75,6 @@ struct PairContext {
   CloudView target, source;
   kernels::DenseGridShape shape;
   const unsigned* start;  // first sorted point of every cell, then the point count
-  int lanes;              // items a source point's candidates are split between
   float radius;           // the query radius: the cut-off at this lengthscale (<= the cell edge)
   float reach2;           // radius^2 and a margin: no pair beyond it can be retained
   Pose3x4 pose;
@@ -85,13 +89,13 @@ struct PairContext {
 
   // f(x, a) for lane `lane`'s share of the candidate target points x of source point j (at z)
   // that may be retained, with the pair's retained weight a (0 when not retained), in the grid's
-  // fixed order: candidates lane, lane + lanes, ... of the point's ranges taken as one stream.
-  // The ranges also hold points beyond the ball (weight 0, which adds nothing to any sum): those
-  // are skipped before their appearance is computed.
+  // fixed order: candidates lane, lane + kLanesPerPoint, ... of the point's ranges taken as one
+  // stream. The ranges also hold points beyond the ball (weight 0, which adds nothing to any
+  // sum): those are skipped before their appearance is computed.
   template <class F>
   CVO_HOST_DEVICE void forEachPair(int j, int lane, const float* z, F&& f) const {
     const bool appearance = k.use_color || k.semantic_classes > 0;
-    const auto step = static_cast<unsigned>(lanes);
+    constexpr auto step = static_cast<unsigned>(kLanesPerPoint);
     unsigned skip = static_cast<unsigned>(lane);  // candidates before this lane's next one
     kernels::forEachRangeWithin(shape, start, z, radius, [&](unsigned begin, unsigned end) {
       if (end - begin <= skip) {
@@ -130,14 +134,14 @@ struct PairContext {
   }
 };
 
-// Item `item`'s share of an evaluation's sums: source point j = item / lanes moved by the pose,
-// then add(context, j, lane, z, sums) over that lane's candidates.
+// Item `item`'s share of an evaluation's sums: source point j = item / kLanesPerPoint moved by
+// the pose, then add(context, j, lane, z, sums) over that lane's candidates.
 template <class Sums, class Add>
 struct ShareOfPoint {
   PairContext c;
   Add add;
   CVO_HOST_DEVICE Sums operator()(int item) const {
-    const int j = item / c.lanes, lane = item % c.lanes;
+    const int j = item / kLanesPerPoint, lane = item % kLanesPerPoint;
     Sums sums;
     kernels::clear(sums);
     float z[3];
@@ -307,7 +311,6 @@ struct DevicePairSums<System>::Impl {
     c.source = {rawPointer(uploaded[1][0]), rawPointer(uploaded[1][1]), rawPointer(uploaded[1][2])};
     c.shape = shape;
     c.start = rawPointer(start);
-    c.lanes = device::kLanesPerPoint;
     c.radius = static_cast<float>(radius);
     // Beyond reach2 a pair's weight is below sp_thres by a factor exp(-0.001) at least: far
     // more than rounding, so the skipped pairs are never retained ones.
@@ -326,7 +329,7 @@ struct DevicePairSums<System>::Impl {
     Sums zero;
     kernels::clear(zero);
     const thrust::counting_iterator<int> points(0);
-    const int items = count[1] * device::kLanesPerPoint;
+    const int items = count[1] * kLanesPerPoint;
     return thrust::transform_reduce(runtime.policy(), points, points + items,
                                     ShareOfPoint<Sums, Add>{context(pose, ell), add}, zero,
                                     AddSums<Sums>{});

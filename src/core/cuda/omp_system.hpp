@@ -21,8 +21,6 @@ namespace device {
 constexpr DeviceSystem kSystem = DeviceSystem::kOmp;
 constexpr const char* kSystemName = "device_cpu";
 
-// The GPU's split of a point's candidates (cuda_system.cuh), so that these tests run its code.
-constexpr int kLanesPerPoint = 32;
 constexpr long kReduceChunk = 64;  // (source point, lane) items a chunk
 
 struct ChunkedReducePolicy : thrust::system::omp::execution_policy<ChunkedReducePolicy> {
