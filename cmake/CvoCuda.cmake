@@ -8,10 +8,37 @@ if(NOT CVO_WITH_CUDA STREQUAL "OFF")
   endif()
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
-    # No GPU to detect at build time: Turing, Ampere desktop, Jetson Orin, Ada, Hopper
-    # (H100/H200, also as PTX for newer chips) and Blackwell desktop.
+    # The architectures: CMAKE_CUDA_ARCHITECTURES when given; else the GPUs nvidia-smi lists
+    # (each architecture's code once: a quick build for this machine), else Turing's code and
+    # its PTX, which the driver of a newer GPU compiles once at the program's first start and
+    # caches. CI builds all that the users have (CVO_CUDA_ARCHITECTURES=all in scripts/env.sh:
+    # "75-real;86-real;87-real;89-real;90;120-real": Turing, Ampere desktop, Jetson Orin, Ada,
+    # Hopper H100/H200 also as PTX for newer chips, Blackwell desktop).
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
-      set(CMAKE_CUDA_ARCHITECTURES "75-real;86-real;87-real;89-real;90;120-real")
+      set(archs "")
+      find_program(CVO_NVIDIA_SMI nvidia-smi)
+      if(CVO_NVIDIA_SMI)
+        execute_process(COMMAND ${CVO_NVIDIA_SMI} --query-gpu=compute_cap --format=csv,noheader
+                        OUTPUT_VARIABLE caps RESULT_VARIABLE rc ERROR_QUIET TIMEOUT 30)
+        if(rc EQUAL 0)
+          string(REGEX MATCHALL "[0-9]+\\.[0-9]+" caps "${caps}")
+          foreach(cap ${caps})
+            string(REPLACE "." "" arch "${cap}")
+            list(APPEND archs ${arch})
+          endforeach()
+          list(REMOVE_DUPLICATES archs)
+        endif()
+      endif()
+      if(archs)
+        message(STATUS "cvo_odometry: CUDA code for this machine's GPUs (nvidia-smi): ${archs}")
+      else()
+        set(archs 75)
+        message(STATUS "cvo_odometry: no GPU listed by nvidia-smi: CUDA code for Turing (75) and "
+                       "its PTX for newer GPUs; set CMAKE_CUDA_ARCHITECTURES to your GPU's "
+                       "(e.g. 86, 87 for Jetson Orin, 90) for a quicker first start")
+      endif()
+      set(CMAKE_CUDA_ARCHITECTURES "${archs}" CACHE STRING
+          "CUDA architectures (default: the GPUs nvidia-smi lists, else 75)")
     endif()
     enable_language(CUDA)
     find_package(CUDAToolkit REQUIRED)
