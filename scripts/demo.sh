@@ -2,7 +2,9 @@
 # What users run, on the bundled real sample: build, turn the TUM fr1_xyz excerpt (37 frames) into
 # a rosbag, play it headless into the cvo_odometry nodelet, write the trajectory
 # (build/demo/trajectory.txt) and print its errors against ground truth. Paced by the nodelet
-# (play_bag.launch pace:=true), so a slow or loaded machine drops no frame.
+# (play_bag.launch pace:=true), so a slow or loaded machine drops no frame. The trajectory must
+# hold a pose for every frame of the bag; otherwise the demo says in one line what failed and
+# exits non-zero.
 # Options: --rviz (watch it; needs a display), --backend auto|cpu|cuda.
 set -euo pipefail
 source "$(dirname "$0")/env.sh"
@@ -10,14 +12,19 @@ rviz=false backend=auto
 while [ $# -gt 0 ]; do
   case "$1" in
     --rviz) rviz=true ;;
-    --backend) backend=$2; shift ;;
+    --backend)
+      [ $# -ge 2 ] || { echo "usage: $0 [--rviz] [--backend auto|cpu|cuda]" >&2; exit 2; }
+      backend=$2; shift ;;
     *) echo "usage: $0 [--rviz] [--backend auto|cpu|cuda]" >&2; exit 2 ;;
   esac
   shift
 done
-cvo_configure
+fail() { echo "demo FAILED: $*" >&2; exit 1; }
+cvo_configure || fail "configuring $CVO_BUILD failed (log: $CVO_BUILD/configure.log)"
 [ "$rviz" = false ] || "$CVO_ROOT/scripts/install_deps.sh" viz
-cmake --build "$CVO_BUILD" -j"$(cvo_jobs)" --target cvo_make_bag cvo_odometry_nodelet cvo_evaluate
+# The package without its tests (`all`): the nodelet, cvo_make_bag, cvo_evaluate and the
+# generated Python messages that play_bag.launch's cvo_wait_idle imports.
+cmake --build "$CVO_BUILD" -j"$(cvo_jobs)" || fail "the build failed (the compiler's errors are above)"
 set +u  # the devel setup reads unset variables
 source "$CVO_BUILD/devel/setup.bash"
 set -u
@@ -26,10 +33,17 @@ bin="$CVO_BUILD/devel/lib/cvo_odometry"
 data="$CVO_ROOT/test/data/tum_fr1_xyz"
 out="$CVO_BUILD/demo"
 mkdir -p "$out"
-"$bin/cvo_make_bag" --tum "$data" --out "$out/tum_fr1_xyz.bag"
+"$bin/cvo_make_bag" --tum "$data" --out "$out/tum_fr1_xyz.bag" || fail "cvo_make_bag failed"
+frames=$(cvo_bag_frames "$out/tum_fr1_xyz.bag") || fail "cannot read $out/tum_fr1_xyz.bag"
 rm -f "$out/trajectory.txt"
-roslaunch cvo_odometry play_bag.launch bag:="$out/tum_fr1_xyz.bag" backend:="$backend" \
-  rate:=0.2 pace:=true rviz:="$rviz" trajectory_file:="$out/trajectory.txt" >"$out/roslaunch.log" 2>&1 || true
-[ -s "$out/trajectory.txt" ] || { tail -30 "$out/roslaunch.log"; echo "no trajectory written" >&2; exit 1; }
-echo "trajectory: $out/trajectory.txt ($(grep -vc '^#' "$out/trajectory.txt") poses; log: $out/roslaunch.log)"
-"$bin/cvo_evaluate" --gt "$data/groundtruth.txt" --est "$out/trajectory.txt"
+cvo_roslaunch_logged "$out/roslaunch.log" cvo_odometry play_bag.launch bag:="$out/tum_fr1_xyz.bag" \
+  backend:="$backend" rate:=0.2 pace:=true rviz:="$rviz" trajectory_file:="$out/trajectory.txt" || true
+poses=0
+[ ! -f "$out/trajectory.txt" ] || poses=$(cvo_pose_count "$out/trajectory.txt")
+if [ "$poses" -ne "$frames" ]; then
+  why=$(cvo_first_error "$out/roslaunch.log")
+  fail "$poses of $frames poses in $out/trajectory.txt${why:+; first error: $why} (log: $out/roslaunch.log)"
+fi
+echo "trajectory: $out/trajectory.txt ($poses of $frames poses; log: $out/roslaunch.log)"
+"$bin/cvo_evaluate" --gt "$data/groundtruth.txt" --est "$out/trajectory.txt" ||
+  fail "cvo_evaluate could not evaluate $out/trajectory.txt"
