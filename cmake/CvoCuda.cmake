@@ -33,9 +33,12 @@ if(NOT CVO_WITH_CUDA STREQUAL "OFF")
         message(STATUS "cvo_odometry: CUDA code for this machine's GPUs (nvidia-smi): ${archs}")
       else()
         set(archs 75)
-        message(STATUS "cvo_odometry: no GPU listed by nvidia-smi: CUDA code for Turing (75) and "
-                       "its PTX for newer GPUs; set CMAKE_CUDA_ARCHITECTURES to your GPU's "
-                       "(e.g. 86, 87 for Jetson Orin, 90) for a quicker first start")
+        message(STATUS "cvo_odometry: no GPU listed by nvidia-smi: CUDA code for Turing (75) "
+                       "and its PTX, which a newer GPU's driver compiles at the first start (can "
+                       "take minutes, then cached). Building for another machine (Docker, a "
+                       "Jetson)? Set CMAKE_CUDA_ARCHITECTURES to its GPU's: 86, 87 (Jetson "
+                       "Orin), 89, 90, 120, or the list CI builds: "
+                       "\"75-real;86-real;87-real;89-real;90;120-real\"")
       endif()
       set(CMAKE_CUDA_ARCHITECTURES "${archs}" CACHE STRING
           "CUDA architectures (default: the GPUs nvidia-smi lists, else 75)")

@@ -11,23 +11,25 @@
 #          installs BUILD_DIR (a build of this package, or a catkin_make workspace's build/) into
 #          a temporary folder (cmake --install with DESTDIR; the build's prefix is untouched)
 #          after building its `all` (as `make install` does), and checks that
-#        scripts/check_install.sh --prefix PREFIX [--hide DIR]...
+#        scripts/check_install.sh --prefix PREFIX [--source DIR] [--hide DIR]...
 #          checks an install space already there (e.g. a workspace's install/ after
-#          `catkin_make install`), hiding the DIRs (e.g. the workspace's build/ and devel/) too
-# Options: --keep (keep the temporary folder), --no-replay (skip the bag replay: ~30 s)
+#          `catkin_make install`) of the package in DIR (default: this checkout), hiding the
+#          DIRs (e.g. the workspace's src/, build/ and devel/) too
+# Options: --keep (keep the temporary folder), --no-replay (skip the bag replay: ~20 s)
 # Prints a line per check; exits non-zero at the first failure with one line saying what failed.
 set -euo pipefail
 source "$(dirname "$0")/env.sh"
 
 usage() {
-  echo "usage: $0 BUILD_DIR | --prefix PREFIX [--hide DIR]...  [--keep] [--no-replay]" >&2
+  echo "usage: $0 BUILD_DIR | --prefix PREFIX [--source DIR] [--hide DIR]...  [--keep] [--no-replay]" >&2
   exit 2
 }
-build="" prefix="" keep=false replay=true hide=()
+build="" prefix="" source_dir="" keep=false replay=true hide=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --prefix) [ $# -ge 2 ] || usage; prefix=$2; shift ;;
     --hide) [ $# -ge 2 ] || usage; hide+=("$2"); shift ;;
+    --source) [ $# -ge 2 ] || usage; source_dir=$2; shift ;;
     --keep) keep=true ;;
     --no-replay) replay=false ;;
     -h|--help) usage ;;
@@ -56,9 +58,14 @@ if [ -n "$build" ]; then
     fail "cmake --install $build failed: $(grep -m1 -iE 'error' "$work/install.log")"
   prefix="$work/destdir$configured_prefix"
   hide+=("$build")
+  # The package's sources that build was configured from (a workspace's copy, a clone).
+  [ -n "$source_dir" ] || source_dir=$(sed -n 's/^cvo_odometry_SOURCE_DIR:STATIC=//p' "$build/CMakeCache.txt")
   echo "installed $build into $prefix (its prefix: $configured_prefix)"
 fi
 [ -f "$prefix/setup.bash" ] || fail "no setup.bash in $prefix: not a catkin install space"
+source_dir=${source_dir:-$CVO_ROOT}
+[ -f "$source_dir/package.xml" ] || fail "$source_dir holds no package (--source)"
+source_dir=$(cd "$source_dir" && pwd)
 prefix=$(cd "$prefix" && pwd)
 share="$prefix/share/cvo_odometry"
 bin="$prefix/lib/cvo_odometry"
@@ -69,7 +76,7 @@ need() { [ -e "$1" ] || missing+=("${1#"$prefix"/}"); }
 for lib in cvo_core cvo_frontend cvo_odometry_ros cvo_odometry_nodelet; do
   need "$prefix/lib/lib$lib.so"
 done
-(cd "$CVO_ROOT/include" && find cvo_odometry -type f) >"$work/headers"
+(cd "$source_dir/include" && find cvo_odometry -type f) >"$work/headers"
 while read -r header; do need "$prefix/include/$header"; done <"$work/headers"
 for generated in CvoIndicator.h ResetToPose.h CvoOdometryConfig.h; do
   need "$prefix/include/cvo_odometry/$generated"
@@ -77,12 +84,13 @@ done
 need "$share/package.xml"
 need "$share/nodelet_plugins.xml"
 for dir in launch config rviz; do
-  for f in "$CVO_ROOT/$dir"/*; do need "$share/$dir/$(basename "$f")"; done
+  for f in "$source_dir/$dir"/*; do need "$share/$dir/$(basename "$f")"; done
 done
 tools=(cvo_run_sequence cvo_evaluate cvo_make_bag cvo_align cvo_soak cvo_make_labels
        cvo_settings_table cvo_benchmark cvo_wait_idle)
 for tool in "${tools[@]}"; do need "$bin/$tool"; done
-[ ${#missing[@]} -eq 0 ] || fail "${#missing[@]} files missing from $prefix: ${missing[*]}"
+[ ${#missing[@]} -eq 0 ] ||
+  fail "${#missing[@]} files missing from $prefix: ${missing[*]:0:8}$([ ${#missing[@]} -le 8 ] || echo " ...")"
 echo "layout: libraries, $(wc -l <"$work/headers") headers + 3 generated, launch, config, rviz," \
   "nodelet_plugins.xml and ${#tools[@]} tools present"
 
@@ -90,7 +98,7 @@ echo "layout: libraries, $(wc -l <"$work/headers") headers + 3 generated, launch
 # preset or fixture paths would only work on the machine that built them). Source file names in
 # log macros (__FILE__) and Python's byte code are no data paths.
 leaks=()
-for dir in "$CVO_ROOT" "${hide[@]}"; do
+for dir in "$source_dir" "$CVO_ROOT" "${hide[@]}"; do
   for sub in config launch rviz test cfg msg devel/share devel/lib; do
     while IFS= read -r f; do leaks+=("${f#"$prefix"/}: $dir/$sub"); done < <(
       grep -rlF --exclude='*.pyc' "$dir/$sub/" "$prefix" 2>/dev/null || true)
@@ -102,7 +110,7 @@ echo "paths: no installed file names the source tree's or the build's data folde
 # --- Run it from the install space alone -------------------------------------------------------
 # The fixture is copied out: the checks below must not see the source tree.
 data="$work/tum_fr1_xyz"
-cp -r "$CVO_ROOT/test/data/tum_fr1_xyz" "$data"
+cp -r "$source_dir/test/data/tum_fr1_xyz" "$data"
 port=$(cvo_free_port)
 { echo "set -euo pipefail"; declare -f cvo_bag_frames cvo_pose_count cvo_first_error cvo_roslaunch_logged; } >"$work/inner.sh"
 cat >>"$work/inner.sh" <<EOF
@@ -203,7 +211,7 @@ clean_env=(env -i HOME="$HOME" PATH=/usr/bin:/bin TMPDIR="${TMPDIR:-/tmp}" LANG=
 if [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
   mkdir -p "$work/empty"
   mounts="" hidden=()
-  for dir in "$CVO_ROOT" "${hide[@]}"; do
+  for dir in "$source_dir" "$CVO_ROOT" "${hide[@]}"; do
     [ -d "$dir" ] || continue
     dir=$(cd "$dir" && pwd)
     inside=false
