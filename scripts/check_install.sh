@@ -210,12 +210,19 @@ EOF
 clean_env=(env -i HOME="$HOME" PATH=/usr/bin:/bin TMPDIR="${TMPDIR:-/tmp}" LANG=C.UTF-8)
 if [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
   mkdir -p "$work/empty"
-  mounts="" hidden=()
+  candidates=()
   for dir in "$source_dir" "$CVO_ROOT" "${hide[@]}"; do
-    [ -d "$dir" ] || continue
-    dir=$(cd "$dir" && pwd)
+    [ -d "$dir" ] && candidates+=("$(cd "$dir" && pwd)")
+  done
+  # Each folder once, none inside another (a mount over the outer one hides it).
+  mounts="" hidden=()
+  for dir in "${candidates[@]}"; do
     inside=false
-    for h in "${hidden[@]}"; do case "$dir/" in "$h"/*) inside=true ;; esac; done
+    for other in "${candidates[@]}" "${hidden[@]}"; do
+      [ "$other" != "$dir" ] || continue
+      case "$dir/" in "$other"/*) inside=true ;; esac
+    done
+    for h in "${hidden[@]}"; do [ "$h" != "$dir" ] || inside=true; done
     [ "$inside" = true ] || { hidden+=("$dir"); mounts+="mount --bind '$work/empty' '$dir' && "; }
   done
   echo "hiding the source tree and build: ${hidden[*]}"
