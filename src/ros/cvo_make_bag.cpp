@@ -6,8 +6,12 @@
 //   KITTI: <ns>/left/image_rect, <ns>/right/image_rect (mono8), <ns>/left|right/camera_info;
 //          stamps are times.txt + 1 s (ROS time 0 means "no stamp"; --gt-out writes the ground
 //          truth at the bag's stamps)
-//   both:  /tf_static base_link -> the camera frame, a camera looking along base_link's x axis
+//          with --segmentation DIR <ns>/segmentation/image (class ids, the left image's stamp)
+//   both:  /tf_static base_link -> the camera frame, a camera looking along base_link's x axis,
+//          latched as a static transform publisher's is
 #include <iostream>
+
+#include <boost/make_shared.hpp>
 
 #include <cv_bridge/cv_bridge.h>
 #include <rosbag/bag.h>
@@ -34,8 +38,10 @@ const char* kUsage =
     "  --gt-out FILE      ground truth (TUM format) at the bag's stamps, for cvo_evaluate\n"
     "  --first N --last N frame range\n"
     "  --stride N         every N-th frame of the range (larger motions per frame)\n"
-    "  --segmentation DIR TUM: each colour image's class ids (DIR/<rgb path> or DIR/<file name>,\n"
-    "                     8 or 16 bit, e.g. from cvo_make_labels) on <ns>/segmentation/image\n";
+    "  --segmentation DIR each colour (KITTI: left) image's class ids, 8 or 16 bit (e.g. from\n"
+    "                     cvo_make_labels), on <ns>/segmentation/image with that image's stamp:\n"
+    "                     TUM DIR/<rgb path> or DIR/<file name>; KITTI DIR/image_0/<name> or\n"
+    "                     DIR/<name>\n";
 
 sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
                                    const std_msgs::Header& header) {
@@ -54,6 +60,8 @@ sensor_msgs::CameraInfo cameraInfo(const cvo::PinholeIntrinsics& K, double tx,
 }
 
 // base -> camera on /tf_static at the first stamp: the bag plays like a robot with a camera.
+// Latched, as tf2's static broadcaster publishes it (rosbag play latches a connection recorded so):
+// a listener started after playback began (rviz, tf_echo) still gets it.
 void writeCameraTransform(rosbag::Bag& bag, const std::string& base, const std::string& camera,
                           const ros::Time& stamp) {
   tf2_msgs::TFMessage tf;
@@ -63,7 +71,29 @@ void writeCameraTransform(rosbag::Bag& bag, const std::string& base, const std::
   t.child_frame_id = camera;
   t.transform = cvo::toTransformMsg(cvo::opticalFrameInBase());
   tf.transforms.push_back(t);
-  bag.write("/tf_static", stamp, tf);
+  using Traits = ros::message_traits::Definition<tf2_msgs::TFMessage>;
+  auto header = boost::make_shared<ros::M_string>();
+  (*header)["topic"] = "/tf_static";
+  (*header)["type"] = ros::message_traits::datatype(tf);
+  (*header)["md5sum"] = ros::message_traits::md5sum(tf);
+  (*header)["message_definition"] = Traits::value();
+  (*header)["callerid"] = "/cvo_make_bag";
+  (*header)["latching"] = "1";
+  bag.write("/tf_static", stamp, tf, header);
+}
+
+// 8 or 16-bit class ids as a mono8 / mono16 image message.
+sensor_msgs::ImagePtr labelsMsg(const cv::Mat& labels, const std::string& what,
+                                const std_msgs::Header& header) {
+  if (labels.channels() != 1 || (labels.depth() != CV_8U && labels.depth() != CV_16U)) {
+    throw std::invalid_argument("--segmentation: " + what +
+                                "'s labels are not 8 or 16-bit class ids");
+  }
+  return cv_bridge::CvImage(header,
+                            labels.depth() == CV_8U ? sensor_msgs::image_encodings::MONO8
+                                                    : sensor_msgs::image_encodings::MONO16,
+                            labels)
+      .toImageMsg();
 }
 
 sensor_msgs::ImagePtr imageMsg(const cv::Mat& image, const std::string& encoding,
@@ -91,9 +121,6 @@ int main(int argc, char** argv) {
     std::size_t written = 0;
     cvo::Trajectory ground_truth;  // at the bag's stamps
     const std::string segmentation = cli.get("segmentation");
-    if (!segmentation.empty() && !cli.has("tum")) {
-      throw std::invalid_argument("--segmentation: TUM only (the stereo nodelet takes no labels)");
-    }
     if (cli.has("tum")) {
       const cvo::TumSequence sequence(cli.get("tum"));
       const std::string gt_path = cli.get("tum") + "/groundtruth.txt";
@@ -115,16 +142,9 @@ int main(int argc, char** argv) {
                   imageMsg(image, sensor_msgs::image_encodings::BGR8, header));
         bag.write(ns + "/rgb/camera_info", header.stamp, cameraInfo(K, 0.0, header));
         if (!segmentation.empty()) {
-          const cv::Mat labels = cvo::readSegmentation(segmentation, f.rgb_listed);
-          if (labels.channels() != 1 || (labels.depth() != CV_8U && labels.depth() != CV_16U)) {
-            throw std::invalid_argument("--segmentation: " + f.rgb_path +
-                                        "'s labels are not 8 or 16-bit class ids");
-          }
-          bag.write(ns + "/segmentation/image", header.stamp,
-                    imageMsg(labels,
-                             labels.depth() == CV_8U ? sensor_msgs::image_encodings::MONO8
-                                                     : sensor_msgs::image_encodings::MONO16,
-                             header));
+          bag.write(
+              ns + "/segmentation/image", header.stamp,
+              labelsMsg(cvo::readSegmentation(segmentation, f.rgb_listed), f.rgb_path, header));
         }
         header.stamp = ros::Time(f.depth_stamp);
         const cv::Mat metres = cvo::depthToMetres(depth, 5000.0, 0.0, 1e9);
@@ -162,6 +182,13 @@ int main(int argc, char** argv) {
                   imageMsg(right, sensor_msgs::image_encodings::MONO8, header));
         bag.write(ns + "/right/camera_info", header.stamp,
                   cameraInfo(calibration.left, tx, header));
+        if (!segmentation.empty()) {
+          // Found as the runner finds them (tool_options: the left image's path, then its name).
+          const std::string left_path =
+              "image_0/" + sequence.imageName(static_cast<std::size_t>(k));
+          bag.write(ns + "/segmentation/image", header.stamp,
+                    labelsMsg(cvo::readSegmentation(segmentation, left_path), left_path, header));
+        }
         ++written;
       }
     }

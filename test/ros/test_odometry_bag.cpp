@@ -10,7 +10,8 @@
 // (cvo_run_sequence's trajectory of the same frames: the nodelet must give the same poses,
 // within runner_tolerance_m), label_classes and ignored_class (segmentation on: the current
 // debug cloud carries a label of fewer classes per point, more than one class, never the ignored
-// one).
+// one), late_tf_static_check (a TF listener started once the first frame is processed, long after
+// the bag's /tf_static was played, still gets base_link <- camera: the bag latches it).
 // Nothing here depends on the machine's speed: the bag is played paused (play_bag.launch
 // start_paused) and resumed by this node only once it receives the nodelet's output, and paced
 // by the nodelet's indicator (play_bag.launch pace), so no frame is missed or dropped however
@@ -115,6 +116,31 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   resume.request.data = false;
   ASSERT_TRUE(ros::service::call(player + "/pause_playback", resume));
   std::cout << "player: " << resume.response.message << "\n";
+  std::string camera_frame;
+  ASSERT_TRUE(pnh.getParam("camera_frame", camera_frame));
+
+  bool late_tf_static_check = false;
+  pnh.param("late_tf_static_check", late_tf_static_check, false);
+  if (late_tf_static_check) {
+    const ros::WallTime first_deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    auto processed = [&] {
+      std::lock_guard<std::mutex> lock(collected.mutex);
+      return !collected.indicators.empty();
+    };
+    while (!processed() && ros::ok() && ros::WallTime::now() < first_deadline)
+      ros::WallDuration(0.05).sleep();
+    ASSERT_TRUE(processed()) << "no frame processed";
+    // Only a latched /tf_static reaches a listener this late (the bag plays it once, first);
+    // the player is still running (paced by the nodelet, at most 0.5 s of bag time ahead).
+    tf2_ros::Buffer late_buffer;
+    tf2_ros::TransformListener late_listener(late_buffer);
+    const ros::WallTime late_deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+    while (!late_buffer.canTransform("base_link", camera_frame, ros::Time(0)) &&
+           ros::WallTime::now() < late_deadline)
+      ros::WallDuration(0.05).sleep();
+    EXPECT_TRUE(late_buffer.canTransform("base_link", camera_frame, ros::Time(0)))
+        << "a listener started during playback did not get the bag's /tf_static";
+  }
 
   // Until every frame came, or enough came and nothing more for 8 s (the bag has ended; only
   // where min_frames < frames, so a slow machine cannot make it fail).
@@ -176,8 +202,6 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   EXPECT_TRUE(tf_buffer.canTransform("odom", "base_link", last.header.stamp, ros::Duration(60.0)));
 
   // The camera's poses: base poses composed with base <- camera (the bag's /tf_static).
-  std::string camera_frame;
-  ASSERT_TRUE(pnh.getParam("camera_frame", camera_frame));
   geometry_msgs::TransformStamped base_from_camera;
   ASSERT_NO_THROW(base_from_camera = tf_buffer.lookupTransform("base_link", camera_frame,
                                                                ros::Time(0), ros::Duration(5.0)));
