@@ -4,6 +4,10 @@
 // 30 Hz, so a depth 15.6 ms after one colour image and 20.2 ms before the next is given to the
 // wrong one. Here each first-stream message is paired with the second-stream message nearest to
 // its stamp plus the learned offset (the median of the recent pairs' offsets), within a tolerance.
+// The first messages wait until the offset is learned (bootstrap_frames of them) and then pair
+// with it, flagged `held`, so that a caller can use them all rather than only the newest: neither
+// nearest-stamp pairing nor an offset from the first pair alone is right on TUM's stamps (the
+// nearest depth of 7 of the fixture's 37 colour images is the next frame's).
 // ROS-free so the pairing is unit-tested on real stamps; the nodelet feeds it message pointers.
 #pragma once
 
@@ -65,6 +69,9 @@ class OrderedStampPairer {
     double first_stamp = 0.0, second_stamp = 0.0;
     First first;
     Second second;
+    // Paired when the offset was learned from it and the messages held with it: the first
+    // frames after a start, a restart or relearn().
+    bool held = false;
   };
 
   explicit OrderedStampPairer(StampPairerOptions options = {}) : options_(std::move(options)) {
@@ -203,7 +210,8 @@ class OrderedStampPairer {
 
   std::vector<Pair> drain() {
     std::vector<Pair> pairs;
-    if (!offset_ && !learn()) {
+    const bool learning = !offset_;
+    if (learning && !learn()) {
       trimQueues();
       return pairs;
     }
@@ -242,7 +250,8 @@ class OrderedStampPairer {
       const bool final = last_second_ + spacing >= target + distance - slack;
       if (!final && !overflow) break;
       pairs.push_back({firsts_.front().stamp, seconds_[best].stamp,
-                       std::move(firsts_.front().message), std::move(seconds_[best].message)});
+                       std::move(firsts_.front().message), std::move(seconds_[best].message),
+                       learning});
       firsts_.pop_front();
       dropped_second_ += best;  // passed over: nearer to no first message
       seconds_.erase(seconds_.begin(), seconds_.begin() + static_cast<std::ptrdiff_t>(best) + 1);
