@@ -124,14 +124,18 @@ void CvoOdometryRos::subscribe() {
   if (node.mode != CameraMode::kRgbd) {
     const SyncPolicy policy =
         node.sync_policy == SyncPolicy::kAuto ? SyncPolicy::kExact : node.sync_policy;
+    StereoSyncOptions options;
+    options.with_disparity = node.mode == CameraMode::kDisparity;
+    options.policy = policy;
+    options.queue_size = node.queue_size;
+    options.min_frame_interval = node.min_frame_interval;
+    options.with_labels = node.use_segmentation;
     stereo_sync_ = std::make_unique<StereoTopicSync>(
-        nh_, it_, hints, node.mode == CameraMode::kDisparity, policy, node.queue_size,
-        node.min_frame_interval,
-        [this](const auto& left, const auto& left_info, const auto& right, const auto& right_info,
-               const auto& disparity) {
-          enqueue(left->header, [&] {
-            return stereoFrameFromMsgs(*left, *left_info, right.get(), right_info.get(),
-                                       disparity.get());
+        nh_, it_, hints, options, [this](const StereoTopicSync::Frame& frame) {
+          enqueue(frame.left->header, [&] {
+            return stereoFrameFromMsgs(*frame.left, *frame.left_info, frame.right.get(),
+                                       frame.right_info.get(), frame.disparity.get(),
+                                       frame.labels.get());
           });
         });
     return;

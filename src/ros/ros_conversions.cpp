@@ -134,10 +134,12 @@ CameraFrame stereoFrameFromMsgs(const sensor_msgs::Image& left,
                                 const sensor_msgs::CameraInfo& left_info,
                                 const sensor_msgs::Image* right,
                                 const sensor_msgs::CameraInfo* right_info,
-                                const stereo_msgs::DisparityImage* disparity) {
+                                const stereo_msgs::DisparityImage* disparity,
+                                const sensor_msgs::Image* labels) {
   StereoFrame frame;
   frame.left = colorImageFromMsg(left);
   frame.intrinsics = intrinsicsFromCameraInfo(left_info);
+  if (labels) frame.semantics = labelImageFromMsg(*labels);
   if (disparity) {
     frame.disparity = disparityImageFromMsg(*disparity);
     frame.baseline = disparity->T;

@@ -1,14 +1,17 @@
 #include "cvo_odometry/ros/stereo_topic_sync.hpp"
 
+#include <algorithm>
+
 #include <boost/function.hpp>
 
 namespace cvo {
 
 StereoTopicSync::StereoTopicSync(ros::NodeHandle nh, image_transport::ImageTransport& it,
-                                 const image_transport::TransportHints& hints, bool with_disparity,
-                                 SyncPolicy policy, int queue_size, double min_frame_interval,
-                                 Callback callback)
+                                 const image_transport::TransportHints& hints,
+                                 const StereoSyncOptions& options, Callback callback)
     : callback_(std::move(callback)) {
+  if (options.queue_size < 1) throw std::invalid_argument("queue_size must be >= 1");
+  const int queue_size = options.queue_size;
   auto image = [&](const std::string& topic) {
     auto filter = std::make_shared<image_transport::SubscriberFilter>(it, topic, queue_size, hints);
     filters_.push_back(filter);
@@ -20,23 +23,59 @@ StereoTopicSync::StereoTopicSync(ros::NodeHandle nh, image_transport::ImageTrans
     filters_.push_back(filter);
     return filter;
   };
+  if (options.with_labels) {
+    StampPairerOptions exact;
+    exact.fixed_offset = 0.0;  // a segmentation image carries its left image's stamp
+    exact.tolerance = 0.0;
+    // Labels come later than the images (a segmentation network): room for a few frames.
+    exact.queue_size = std::max<std::size_t>(static_cast<std::size_t>(queue_size), 20);
+    labels_.emplace(exact);
+  }
   auto left = image("left/image_rect");
   // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
   left->registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
       [this](const sensor_msgs::ImageConstPtr&) { ++arrived_; }));
   auto left_info = info("left/camera_info");
-  if (!with_disparity) {
+  if (!options.with_disparity) {
     auto right = image("right/image_rect");
     auto right_info = info("right/camera_info");
-    sync_ = synchronize(policy, queue_size, min_frame_interval, &StereoTopicSync::onImages, this,
-                        *left, *left_info, *right, *right_info);
+    sync_ = synchronize(options.policy, queue_size, options.min_frame_interval,
+                        &StereoTopicSync::onImages, this, *left, *left_info, *right, *right_info);
+  } else {
+    auto disparity = std::make_shared<message_filters::Subscriber<stereo_msgs::DisparityImage>>(
+        nh, "disparity", queue_size);
+    filters_.push_back(disparity);
+    sync_ = synchronize(options.policy, queue_size, options.min_frame_interval,
+                        &StereoTopicSync::onDisparity, this, *left, *left_info, *disparity);
+  }
+  if (!labels_) return;
+  labels_sub_ =
+      it.subscribe("segmentation/image", static_cast<uint32_t>(queue_size),
+                   boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+                       [this](const sensor_msgs::ImageConstPtr& labels) {
+                         std::lock_guard<std::mutex> lock(labels_mutex_);
+                         onLabelled(labels_->addSecond(labels->header.stamp.toSec(), labels));
+                       }),
+                   ros::VoidPtr(), hints);
+}
+
+void StereoTopicSync::onSet(Frame frame) {
+  if (!labels_) {
+    callback_(frame);
     return;
   }
-  auto disparity = std::make_shared<message_filters::Subscriber<stereo_msgs::DisparityImage>>(
-      nh, "disparity", queue_size);
-  filters_.push_back(disparity);
-  sync_ = synchronize(policy, queue_size, min_frame_interval, &StereoTopicSync::onDisparity, this,
-                      *left, *left_info, *disparity);
+  std::lock_guard<std::mutex> lock(labels_mutex_);
+  const double stamp = frame.left->header.stamp.toSec();
+  onLabelled(labels_->addFirst(stamp, std::move(frame)));
+}
+
+void StereoTopicSync::onLabelled(
+    const std::vector<OrderedStampPairer<Frame, sensor_msgs::ImageConstPtr>::Pair>& frames) {
+  for (const auto& pair : frames) {
+    Frame frame = pair.first;
+    frame.labels = pair.second;
+    callback_(frame);
+  }
 }
 
 }  // namespace cvo

@@ -152,6 +152,23 @@ TEST(RosConversions, FramesFromMessagesRefuseWhatTheyCannotRead) {
   EXPECT_THROW(cvo::rgbdFrameFromMsgs(image, info, depth, nullptr), std::invalid_argument);
   EXPECT_THROW(cvo::stereoFrameFromMsgs(image, info, nullptr, nullptr, nullptr),
                std::invalid_argument);
+  // Stereo labels are the left image's; an encoding that is no class ids is refused (the
+  // nodelet skips and counts the frame).
+  info.K[0] = 2;
+  sensor_msgs::CameraInfo right = info;
+  info.P = {2, 0, 2, 0, 0, 2, 1.5, 0, 0, 0, 1, 0};
+  right.P = {2, 0, 2, -0.2, 0, 2, 1.5, 0, 0, 0, 1, 0};
+  sensor_msgs::Image labels = image;
+  labels.encoding = "mono8";
+  labels.step = 4;
+  labels.data.assign(12, 3);
+  const cvo::CameraFrame stereo =
+      cvo::stereoFrameFromMsgs(image, info, &image, &right, nullptr, &labels);
+  EXPECT_EQ(std::get<cvo::StereoFrame>(stereo).semantics.at<std::uint8_t>(2, 3), 3);
+  EXPECT_NEAR(std::get<cvo::StereoFrame>(stereo).baseline, 0.1, 1e-12);
+  labels.encoding = "rgb8";
+  EXPECT_THROW(cvo::stereoFrameFromMsgs(image, info, &image, &right, nullptr, &labels),
+               std::invalid_argument);
 }
 
 TEST(RosConversions, TheDefaultCameraLooksAlongTheBaseXAxis) {

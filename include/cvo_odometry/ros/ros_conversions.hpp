@@ -37,15 +37,16 @@ cv::Mat labelImageFromMsg(const sensor_msgs::Image& msg);
 cv::Mat disparityImageFromMsg(const stereo_msgs::DisparityImage& msg);
 
 // A pipeline frame from the synchronized messages (labels may be null; right and right_info are
-// null with a disparity image, disparity null without). Throws std::invalid_argument naming
-// what is wrong with a message.
+// null with a disparity image, disparity null without; stereo labels are the left image's).
+// Throws std::invalid_argument naming what is wrong with a message.
 CameraFrame rgbdFrameFromMsgs(const sensor_msgs::Image& image, const sensor_msgs::CameraInfo& info,
                               const sensor_msgs::Image& depth, const sensor_msgs::Image* labels);
 CameraFrame stereoFrameFromMsgs(const sensor_msgs::Image& left,
                                 const sensor_msgs::CameraInfo& left_info,
                                 const sensor_msgs::Image* right,
                                 const sensor_msgs::CameraInfo* right_info,
-                                const stereo_msgs::DisparityImage* disparity);
+                                const stereo_msgs::DisparityImage* disparity,
+                                const sensor_msgs::Image* labels = nullptr);
 
 // base <- camera optical frame for a camera looking along the base's x axis (REP-103: the
 // optical frame is z forward, x right, y down; the body frame x forward, y left, z up).
