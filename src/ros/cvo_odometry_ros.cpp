@@ -1,5 +1,9 @@
 #include "cvo_odometry/ros/cvo_odometry_ros.hpp"
 
+#include <cmath>
+#include <limits>
+#include <sstream>
+
 #include <nav_msgs/Odometry.h>
 
 #include "cvo_odometry/core/backend_factory.hpp"
@@ -13,6 +17,15 @@
 namespace cvo {
 
 using cvo_odometry::CvoOdometryConfig;
+
+namespace {
+
+// An RGB-D frame before the first rgb/camera_info: skipped, counted apart from unreadable input.
+struct NoCameraInfo : std::invalid_argument {
+  NoCameraInfo() : std::invalid_argument("no rgb/camera_info received yet") {}
+};
+
+}  // namespace
 
 CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh),
@@ -154,7 +167,8 @@ void CvoOdometryRos::subscribe() {
   options.tolerance = node.sync_tolerance;
   options.with_labels = node.use_segmentation;
   rgbd_sync_ = std::make_unique<RgbdTopicSync>(
-      it_, hints, options, [this](const auto& image, const auto& depth, const auto& labels) {
+      it_, hints, options,
+      [this](const auto& image, const auto& depth, const auto& labels, bool held) {
         sensor_msgs::CameraInfoConstPtr info;
         {
           std::lock_guard<std::mutex> lock(info_mutex_);
@@ -162,25 +176,57 @@ void CvoOdometryRos::subscribe() {
         }
         std_msgs::Header header = depth->header;  // the pose is stamped with the depth time
         if (!image->header.frame_id.empty()) header.frame_id = image->header.frame_id;
-        enqueue(header, [&] {
-          if (!info) throw std::invalid_argument("no rgb/camera_info received yet");
-          return rgbdFrameFromMsgs(*image, *info, *depth, labels.get());
-        });
+        enqueue(
+            header,
+            [&] {
+              if (!info) throw NoCameraInfo();
+              return rgbdFrameFromMsgs(*image, *info, *depth, labels.get());
+            },
+            held);
       });
 }
 
 void CvoOdometryRos::enqueue(const std_msgs::Header& header,
-                             const std::function<CameraFrame()>& convert) {
+                             const std::function<CameraFrame()>& convert, bool held) {
   if (paused_) {
     diagnostics_->countPaused();
     return;
   }
+  const ros::Time now = ros::Time::now();
+  const bool far = checkClock(header.stamp, now);
   try {
-    queue_.push(QueuedFrame{header, convert()});
+    queue_.push(QueuedFrame{header, convert(), now, far}, held);
+  } catch (const NoCameraInfo& e) {
+    diagnostics_->countSkipped(SkipReason::kNoCameraInfo, e.what());
+    ROS_WARN_STREAM_THROTTLE(2.0, pnh_.getNamespace() << ": frame skipped: " << e.what());
   } catch (const std::exception& e) {
-    diagnostics_->countSkipped(e.what());
+    diagnostics_->countSkipped(SkipReason::kUnreadable, e.what());
     ROS_WARN_STREAM_THROTTLE(2.0, pnh_.getNamespace() << ": frame skipped: " << e.what());
   }
+}
+
+bool CvoOdometryRos::checkClock(const ros::Time& stamp, const ros::Time& now) {
+  const double behind = (now - stamp).toSec();
+  diagnostics_->clockOffset(behind);
+  if (std::abs(behind) <= OdometryDiagnostics::kFarFromClock) return false;
+  std::ostringstream why;
+  if (now.isZero()) {
+    why << "this node's clock reads 0: use_sim_time is true and nothing publishes /clock (play "
+           "the bag with rosbag play --clock)";
+  } else if (ros::Time::isSimTime()) {
+    why << "use_sim_time is true and /clock is at " << now
+        << ": the stamps come from another clock (a live camera while a bag plays with --clock?)";
+  } else {
+    why << "this node runs on the wall clock: a bag played without --clock, or /use_sim_time set "
+           "after the nodelet started (set it before, and play with rosbag play --clock, as "
+           "play_bag.launch does), or a camera whose clock is not this machine's";
+  }
+  ROS_WARN_STREAM_THROTTLE(
+      60.0, pnh_.getNamespace() << ": frame stamps are " << std::abs(behind) << " s "
+                                << (behind > 0.0 ? "behind" : "ahead of")
+                                << " this node's clock (stamp " << stamp << ", clock " << now
+                                << "): " << why.str() << ". latency_ms is NaN while this lasts.");
+  return true;
 }
 
 void CvoOdometryRos::work() {
@@ -190,7 +236,7 @@ void CvoOdometryRos::work() {
     } catch (const std::exception& e) {
       // A bug, not bad input (the pipeline classifies that): report it and keep running.
       ROS_ERROR_STREAM(pnh_.getNamespace() << ": frame failed: " << e.what());
-      diagnostics_->countSkipped(e.what());
+      diagnostics_->countSkipped(SkipReason::kInternalError, e.what());
     }
   }
 }
@@ -204,10 +250,18 @@ void CvoOdometryRos::handle(const QueuedFrame& queued) {
   std_msgs::Header header = queued.header;
   if (!settings_.node.camera_frame.empty()) header.frame_id = settings_.node.camera_frame;
   if (!base_from_camera_) base_from_camera_ = baseFromCamera(header.frame_id);
+  const std::optional<double> last_stamp = pipeline_->odometry().lastStamp();
   const PipelineResult result =
       pipeline_->process(header.stamp.toSec(), queued.frame, *base_from_camera_);
-  const double latency_ms = (ros::Time::now() - header.stamp).toSec() * 1000.0;
-  diagnostics_->count(result, latency_ms);
+  const ros::Time now = ros::Time::now();
+  const double latency_ms = queued.far_from_clock ? std::numeric_limits<double>::quiet_NaN()
+                                                  : (now - header.stamp).toSec() * 1000.0;
+  if (result.outcome == FrameOutcome::kSkipped && last_stamp &&
+      *last_stamp == header.stamp.toSec()) {
+    diagnostics_->countSkipped(SkipReason::kRepeatedStamp, result.why);
+  } else {
+    diagnostics_->count(result, latency_ms);
+  }
   if (!result.why.empty()) {
     if (result.outcome == FrameOutcome::kProcessed) {
       ROS_WARN_STREAM(pnh_.getNamespace() << ": " << result.why);

@@ -1,26 +1,49 @@
 #include "cvo_odometry/ros/odometry_diagnostics.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace cvo {
+
+const char* skipReasonName(SkipReason reason) {
+  switch (reason) {
+    case SkipReason::kNoCameraInfo:
+      return "no camera_info yet";
+    case SkipReason::kUnreadable:
+      return "unreadable message";
+    case SkipReason::kRefused:
+      return "refused by the odometry";
+    case SkipReason::kRepeatedStamp:
+      return "repeated stamp";
+    case SkipReason::kInternalError:
+      return "internal error";
+  }
+  return "unknown";
+}
 
 OdometryDiagnostics::OdometryDiagnostics(ros::NodeHandle nh, ros::NodeHandle pnh, SyncState sync)
     : sync_(std::move(sync)), updater_(nh, pnh, pnh.getNamespace()) {
   updater_.setHardwareID("cvo_odometry");
   updater_.add("odometry", this, &OdometryDiagnostics::diagnose);
-  rate_ = std::make_unique<diagnostic_updater::HeaderlessTopicDiagnostic>(
-      "odom", updater_, diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_));
-  timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  updater_.add("odom topic status", this, &OdometryDiagnostics::diagnoseRate);
+  // Every second of the node's clock. force_update: update() waits for a time it computed
+  // before the clock went backwards (a looping bag) and would publish nothing until then.
+  timer_ = nh.createTimer(ros::Duration(1.0),
+                          [this](const ros::TimerEvent&) { updater_.force_update(); });
+}
+
+void OdometryDiagnostics::odometryPublished() {
+  const double now = ros::Time::now().toSec();
+  std::lock_guard<std::mutex> lock(mutex_);
+  rate_.tick(now);
 }
 
 void OdometryDiagnostics::count(const PipelineResult& result, double latency_ms) {
   std::lock_guard<std::mutex> lock(mutex_);
   latency_ms_ = latency_ms;
-  max_latency_ms_ = std::max(max_latency_ms_, latency_ms);
+  if (std::isfinite(latency_ms)) max_latency_ms_ = std::max(max_latency_ms_, latency_ms);
   if (result.outcome == FrameOutcome::kSkipped) {
-    ++skipped_;
-    last_problem_ = "skipped: " + result.why;
+    skipped(SkipReason::kRefused, result.why);  // the caller tells a repeated stamp apart
     return;
   }
   if (result.outcome == FrameOutcome::kStale) {
@@ -51,10 +74,16 @@ void OdometryDiagnostics::count(const PipelineResult& result, double latency_ms)
   if (!update.report.warning.empty()) ++fallbacks_;
 }
 
-void OdometryDiagnostics::countSkipped(const std::string& why) {
+void OdometryDiagnostics::countSkipped(SkipReason reason, const std::string& why) {
   std::lock_guard<std::mutex> lock(mutex_);
+  skipped(reason, why);
+}
+
+void OdometryDiagnostics::skipped(SkipReason reason, const std::string& why) {
   ++skipped_;
-  last_problem_ = "skipped: " + why;
+  ++skipped_by_reason_.at(static_cast<std::size_t>(reason));
+  latest_skip_ = std::string(skipReasonName(reason)) + ": " + why;
+  last_problem_ = "skipped (" + latest_skip_ + ")";
 }
 
 void OdometryDiagnostics::setBackend(const std::string& backend) {
@@ -62,12 +91,38 @@ void OdometryDiagnostics::setBackend(const std::string& backend) {
   backend_ = backend;
 }
 
+void OdometryDiagnostics::diagnoseRate(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const double now = ros::Time::now().toSec();
+  std::lock_guard<std::mutex> lock(mutex_);
+  const EventRate::Judgement judgement = rate_.judge(now);
+  status.summary(judgement.warn ? diagnostic_msgs::DiagnosticStatus::WARN
+                                : diagnostic_msgs::DiagnosticStatus::OK,
+                 judgement.message);
+  // The keys of diagnostic_updater's frequency status, which monitors may read.
+  status.add("Events in window", judgement.events);
+  status.add("Events since startup", rate_.total());
+  status.add("Duration of window (s)", judgement.span);
+  if (judgement.measured) status.add("Actual frequency (Hz)", judgement.rate);
+  status.add("Minimum acceptable frequency (Hz)",
+             rate_.options().min_rate * (1.0 - rate_.options().tolerance));
+  status.add("Maximum acceptable frequency (Hz)",
+             rate_.options().max_rate * (1.0 + rate_.options().tolerance));
+}
+
 void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::lock_guard<std::mutex> lock(mutex_);
+  const bool far_from_clock = clock_offset_ && std::abs(*clock_offset_) > kFarFromClock;
+  char text[200];
   if (frames_ == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no frame processed yet");
   } else if (lost_now_) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "tracking lost: " + lost_problem_);
+  } else if (far_from_clock) {
+    std::snprintf(text, sizeof text,
+                  "frame stamps are %.3g s %s this node's clock (use_sim_time and rosbag play "
+                  "--clock?): latency unknown",
+                  std::abs(*clock_offset_), *clock_offset_ > 0.0 ? "behind" : "ahead of");
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, text);
   } else if (!last_problem_.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, last_problem_);
   } else {
@@ -76,6 +131,11 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   const std::size_t dropped = sync_.dropped ? sync_.dropped() : 0;
   status.add("frames", frames_);
   status.add("skipped frames", skipped_);
+  for (std::size_t k = 0; k < kSkipReasons; ++k) {
+    status.add(std::string("skipped: ") + skipReasonName(static_cast<SkipReason>(k)),
+               skipped_by_reason_[k]);
+  }
+  status.add("latest skip reason", latest_skip_.empty() ? std::string("none") : latest_skip_);
   status.add("stale frames", stale_);
   status.add("frames dropped for latency", dropped);
   status.add("frames dropped while paused", paused_);
@@ -85,8 +145,19 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   if (const auto offset = sync_.offset ? sync_.offset() : std::nullopt) {
     status.add("depth - colour stamp offset (ms)", *offset * 1000.0);
   }
-  status.add("latency (ms, stamp to publish)", latency_ms_);
+  if (std::isfinite(latency_ms_)) {
+    status.add("latency (ms, stamp to publish)", latency_ms_);
+  } else {
+    status.add("latency (ms, stamp to publish)",
+               std::string("unknown: the stamps are far from this node's clock"));
+  }
   status.add("largest latency (ms)", max_latency_ms_);
+  if (clock_offset_) {
+    std::snprintf(text, sizeof text, "%.3f", *clock_offset_);
+    status.add("clock - stamp at arrival (s)", std::string(text));
+  } else {
+    status.add("clock - stamp at arrival (s)", std::string("none yet"));
+  }
   status.add("lost frames", lost_);
   status.add("recovered frames", recovered_);
   status.add("tracking restarts", restarts_);

@@ -33,9 +33,10 @@ void RgbdTopicSync::relearn() {
   if (colour_depth_) colour_depth_->relearn();
 }
 
-void RgbdTopicSync::deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels) {
+void RgbdTopicSync::deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels,
+                            bool held) {
   arrived_since_frame_ = 0;
-  callback_(image, depth, labels);
+  callback_(image, depth, labels, held);
 }
 
 void RgbdTopicSync::countArrival(const ros::Time& stamp) {
@@ -107,23 +108,24 @@ void RgbdTopicSync::onPairs(
         "cvo_odometry: learning the depth - colour stamp offset again (a reset, "
         "time going backwards, or frames that stopped pairing"
         << (std::isnan(old) ? std::string() : " with the offset " + std::to_string(old) + " s")
-        << "); the next frames wait for it");
+        << "); the next frames wait for it, then all are used");
   }
   const auto offset = colour_depth_->offset();
   offset_ = offset ? *offset : std::numeric_limits<double>::quiet_NaN();
   for (const auto& pair : pairs) {
     if (!with_labels_) {
-      deliver(pair.first, pair.second, nullptr);
+      deliver(pair.first, pair.second, nullptr, pair.held);
       continue;
     }
-    onLabelledFrames(with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second}));
+    onLabelledFrames(
+        with_labels_->addFirst(pair.first_stamp, {pair.first, pair.second, pair.held}));
   }
 }
 
 void RgbdTopicSync::onLabelledFrames(
     const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames) {
   for (const auto& frame : frames)
-    deliver(frame.first.first, frame.first.second, frame.second);
+    deliver(frame.first.colour, frame.first.depth, frame.second, frame.first.held);
 }
 
 void RgbdTopicSync::subscribeFilters(image_transport::ImageTransport& it,

@@ -1,9 +1,10 @@
 // rostest node: bad input and tracking failures through the nodelet, with real TUM frames
 // published here and the backend made to fail mid-run by the inject_backend_fault_after hook.
 // Malformed input (no camera_info yet, NaN intrinsics, mismatched sizes, a wrong encoding) is
-// skipped and counted; frames with nothing to track (no valid depth, too few points, a blank
-// image, a large jump) are reported lost, never as trusted poses, with a grown covariance; good
-// frames after all of it are tracked again, on the CPU after the backend failure.
+// skipped and counted, per reason, with the latest reason in the diagnostics; frames with nothing
+// to track (no valid depth, too few points, a blank image, a large jump) are reported lost, never
+// as trusted poses, with a grown covariance; good frames after all of it are tracked again, on the
+// CPU after the backend failure.
 #include <cmath>
 #include <limits>
 
@@ -42,6 +43,9 @@ TEST_F(BadInput, MalformedInputIsSkippedFailuresAreFlaggedAndTrackingResumes) {
   publish(0, next());
   ASSERT_EQ(waitForSkipped(1), 1);
   EXPECT_EQ(waitFor(0), 0u);
+  EXPECT_EQ(diagnostic("skipped: no camera_info yet"), "1");
+  EXPECT_EQ(diagnostic("latest skip reason").rfind("no camera_info yet: ", 0), 0u)
+      << diagnostic("latest skip reason");
   // NaN intrinsics: skipped.
   sensor_msgs::CameraInfo nan_info = cameraInfo();
   nan_info.K[0] = nan_info.P[0] = std::numeric_limits<double>::quiet_NaN();
@@ -49,6 +53,9 @@ TEST_F(BadInput, MalformedInputIsSkippedFailuresAreFlaggedAndTrackingResumes) {
   publish(1, next());
   ASSERT_EQ(waitForSkipped(2), 2);
   EXPECT_EQ(waitFor(0), 0u);
+  EXPECT_EQ(diagnostic("skipped: unreadable message"), "1");
+  EXPECT_NE(diagnostic("latest skip reason").find("non-finite"), std::string::npos)
+      << diagnostic("latest skip reason");
 
   ASSERT_NO_FATAL_FAILURE(publishInfo(cameraInfo()));
   publish(2, next());
@@ -70,6 +77,13 @@ TEST_F(BadInput, MalformedInputIsSkippedFailuresAreFlaggedAndTrackingResumes) {
   publish(cv_bridge::CvImage(header(t), enc::BGR16, wide).toImageMsg(), depth(4, t));
   ASSERT_EQ(waitForSkipped(4), 4);
   EXPECT_EQ(waitFor(2), 2u);
+  // Per reason: the depth of another size is refused by the odometry, the colour encoding is
+  // unreadable.
+  EXPECT_EQ(diagnostic("skipped: no camera_info yet"), "1");
+  EXPECT_EQ(diagnostic("skipped: unreadable message"), "2");
+  EXPECT_EQ(diagnostic("skipped: refused by the odometry"), "1");
+  EXPECT_EQ(diagnostic("skipped: repeated stamp"), "0");
+  EXPECT_EQ(diagnostic("skipped: internal error"), "0");
 
   // No valid depth: a lost frame, published as the flagged guess with a grown covariance.
   t = next();

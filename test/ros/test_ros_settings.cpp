@@ -8,7 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
 #include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/ros/event_rate.hpp"
+#include "cvo_odometry/ros/frame_queue.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
 #include "cvo_odometry/ros/settings_reconfigure.hpp"
 
@@ -169,6 +174,90 @@ TEST(RosConversions, FramesFromMessagesRefuseWhatTheyCannotRead) {
   labels.encoding = "rgb8";
   EXPECT_THROW(cvo::stereoFrameFromMsgs(image, info, &image, &right, nullptr, &labels),
                std::invalid_argument);
+}
+
+// Under simulated time the clock starts at the bag's time, decades after 0: the rate is judged
+// from the first reading on, and only once a whole window has been watched.
+TEST(EventRate, NoJudgementBeforeAWholeWindowThenTheRate) {
+  cvo::EventRate rate;  // 5 s window, 1-100 Hz
+  EXPECT_FALSE(rate.judge(0.0).warn) << "no clock yet (use_sim_time before /clock)";
+  EXPECT_NE(rate.judge(0.0).message.find("no clock"), std::string::npos);
+  const double start = 1305031102.175;  // the fixture's first stamp
+  // A short bag: 37 frames at 30 Hz, judged every second of its time; never a verdict.
+  for (int k = 0; k < 37; ++k) {
+    const double now = start + k / 30.0;
+    rate.tick(now);
+    if (k % 30 == 0) {
+      const auto judgement = rate.judge(now);
+      EXPECT_FALSE(judgement.warn) << judgement.message;
+      EXPECT_FALSE(judgement.measured);
+      EXPECT_EQ(judgement.message.rfind("starting", 0), 0u) << judgement.message;
+    }
+  }
+  // Frames at 30 Hz until a whole window has been watched: measured, within bounds.
+  double now = start + 36 / 30.0;
+  for (int k = 37; k < 200; ++k)
+    rate.tick(now = start + k / 30.0);
+  auto judgement = rate.judge(now);
+  EXPECT_TRUE(judgement.measured);
+  EXPECT_FALSE(judgement.warn) << judgement.message;
+  EXPECT_NEAR(judgement.rate, 30.0, 0.5);
+  // The odometry stops: too low, once the window holds nothing.
+  judgement = rate.judge(now + 6.0);
+  EXPECT_TRUE(judgement.warn);
+  EXPECT_DOUBLE_EQ(judgement.rate, 0.0);
+  EXPECT_NE(judgement.message.find("too low"), std::string::npos) << judgement.message;
+  // A looping bag: time goes back to the start; measured afresh, no verdict meanwhile.
+  rate.tick(start);
+  judgement = rate.judge(start + 1.0);
+  EXPECT_FALSE(judgement.warn) << judgement.message;
+  EXPECT_NE(judgement.message.find("backwards"), std::string::npos) << judgement.message;
+  EXPECT_EQ(judgement.events, 1u);
+  // Far too many (a driver looping a frame as fast as it can): too high.
+  cvo::EventRate fast;
+  for (int k = 0; k <= 5000; ++k)
+    fast.tick(100.0 + k * 0.001);
+  EXPECT_TRUE(fast.judge(105.0).warn);
+  EXPECT_NE(fast.judge(105.0).message.find("too high"), std::string::npos);
+}
+
+// Live: only the newest frame waits, except the first frames of a start, which are kept.
+TEST(FrameQueue, KeptFramesWaitTheirTurnOthersAreReplaced) {
+  cvo::FrameQueue<int> live(false);
+  live.push(1, true);
+  live.push(2, true);
+  live.push(3);
+  live.push(4);  // replaces 3, not the kept ones
+  EXPECT_EQ(live.dropped(), 1u);
+  EXPECT_EQ(live.waiting(), 3u);
+  EXPECT_EQ(live.pop(), std::optional<int>(1));
+  EXPECT_EQ(live.pop(), std::optional<int>(2));
+  EXPECT_EQ(live.pop(), std::optional<int>(4));
+  cvo::FrameQueue<int> replay(true);
+  for (int k = 0; k < 4; ++k)
+    replay.push(k);
+  EXPECT_EQ(replay.dropped(), 0u);
+  EXPECT_EQ(replay.waiting(), 4u);
+}
+
+// cvo_make_bag's bags (made at build time in test/bags) latch /tf_static, as rosbag records a
+// static transform publisher's: rosbag play then latches it, so a listener started after playback
+// began (rviz, tf_echo) still gets base_link -> camera.
+TEST(MadeBags, TfStaticIsLatched) {
+  for (const std::string name : {"tum_fr1_xyz.bag", "kitti_06.bag"}) {
+    const std::string path = std::string(CVO_SOURCE_DIR) + "/test/bags/" + name;
+    rosbag::Bag bag;
+    ASSERT_NO_THROW(bag.open(path, rosbag::bagmode::Read))
+        << path << ": made by the build's test bags (target cvo_test_bags)";
+    rosbag::View view(bag, rosbag::TopicQuery("/tf_static"));
+    const auto connections = view.getConnections();
+    ASSERT_EQ(connections.size(), 1u) << name;
+    const auto& header = *connections.front()->header;
+    ASSERT_EQ(header.count("latching"), 1u) << name;
+    EXPECT_EQ(header.at("latching"), "1") << name;
+    EXPECT_EQ(header.at("type"), "tf2_msgs/TFMessage") << name;
+    EXPECT_EQ(view.size(), 1u) << name;
+  }
 }
 
 TEST(RosConversions, TheDefaultCameraLooksAlongTheBaseXAxis) {

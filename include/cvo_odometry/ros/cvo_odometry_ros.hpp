@@ -49,10 +49,17 @@ class CvoOdometryRos {
   struct QueuedFrame {
     std_msgs::Header header;  // stamp of the pose, frame_id of the camera
     CameraFrame frame;
+    ros::Time arrival;            // the node's clock when the frame was queued
+    bool far_from_clock = false;  // its stamp was far from that clock: no latency
   };
 
   void subscribe();
-  void enqueue(const std_msgs::Header& header, const std::function<CameraFrame()>& convert);
+  // Converts and queues a frame; `held`: one of the first frames after a start, which waited
+  // for the synchronizer (kept in live mode rather than replaced by the next).
+  void enqueue(const std_msgs::Header& header, const std::function<CameraFrame()>& convert,
+               bool held = false);
+  // Warns (throttled) when a frame's stamp is far from the node's clock; returns whether it is.
+  bool checkClock(const ros::Time& stamp, const ros::Time& now);
   void work();
   void handle(const QueuedFrame& queued);
   void publish(const std_msgs::Header& header, const PipelineResult& result, double latency_ms);

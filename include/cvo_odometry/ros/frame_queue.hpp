@@ -2,8 +2,11 @@
 // false) it holds only the newest frame: one that arrives while another waits replaces it, and
 // the replaced one is counted as dropped, so latency stays bounded by one frame's processing
 // whatever the load. For bag replay (keep_all true) every frame waits its turn, in order.
+// A frame pushed with `keep` (the first frames of a start, which waited for the synchronizer's
+// stamp offset and come together) is never replaced: it waits its turn like a replayed frame.
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -17,14 +20,16 @@ class FrameQueue {
  public:
   explicit FrameQueue(bool keep_all) : keep_all_(keep_all) {}
 
-  void push(Frame frame) {
+  void push(Frame frame, bool keep = false) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!keep_all_ && !frames_.empty()) {
-        dropped_ += frames_.size();
-        frames_.clear();
+      if (!keep_all_) {
+        const auto replaced = std::remove_if(frames_.begin(), frames_.end(),
+                                             [](const Waiting& waiting) { return !waiting.keep; });
+        dropped_ += static_cast<std::size_t>(frames_.end() - replaced);
+        frames_.erase(replaced, frames_.end());
       }
-      frames_.push_back(std::move(frame));
+      frames_.push_back({std::move(frame), keep});
     }
     ready_.notify_one();
   }
@@ -34,7 +39,7 @@ class FrameQueue {
     std::unique_lock<std::mutex> lock(mutex_);
     ready_.wait(lock, [this] { return closed_ || !frames_.empty(); });
     if (closed_) return std::nullopt;
-    Frame frame = std::move(frames_.front());
+    Frame frame = std::move(frames_.front().frame);
     frames_.pop_front();
     return frame;
   }
@@ -64,10 +69,15 @@ class FrameQueue {
   }
 
  private:
+  struct Waiting {
+    Frame frame;
+    bool keep;
+  };
+
   const bool keep_all_;
   mutable std::mutex mutex_;
   std::condition_variable ready_;
-  std::deque<Frame> frames_;
+  std::deque<Waiting> frames_;
   std::size_t dropped_ = 0;
   bool closed_ = false;
 };

@@ -1,6 +1,7 @@
 // The RGB-D topics (colour, depth, optional segmentation) subscribed and synchronized by the
 // chosen policy: message_filters' exact or approximate policy, or the ordered pairing of colour
 // and depth with a learned stamp offset (a segmentation image then pairs by its colour stamp).
+// The ordered policy's first frames wait for the offset and then come together, flagged `held`.
 #pragma once
 
 #include <atomic>
@@ -30,10 +31,12 @@ struct RgbdSyncOptions {
 
 class RgbdTopicSync {
  public:
-  // Colour, depth and labels (null without segmentation), one frame at a time in stamp order.
+  // Colour, depth and labels (null without segmentation), one frame at a time in stamp order;
+  // `held`: one of the first frames, which waited for the ordered policy's stamp offset (a
+  // live consumer should use it rather than replace it with the next).
   using Callback = std::function<void(const sensor_msgs::ImageConstPtr& image,
                                       const sensor_msgs::ImageConstPtr& depth,
-                                      const sensor_msgs::ImageConstPtr& labels)>;
+                                      const sensor_msgs::ImageConstPtr& labels, bool held)>;
 
   // Subscribes rgb/image_rect_color, depth_registered/image_rect and, with labels,
   // segmentation/image through `it`. Throws std::invalid_argument for bad options.
@@ -49,7 +52,10 @@ class RgbdTopicSync {
 
  private:
   using ImagePtr = sensor_msgs::ImageConstPtr;
-  using ColourDepth = std::pair<ImagePtr, ImagePtr>;
+  struct ColourDepth {
+    ImagePtr colour, depth;
+    bool held = false;
+  };
 
   void subscribeOrdered(image_transport::ImageTransport& it,
                         const image_transport::TransportHints& hints);
@@ -58,13 +64,13 @@ class RgbdTopicSync {
   void onPairs(const std::vector<OrderedStampPairer<ImagePtr, ImagePtr>::Pair>& pairs);
   void onLabelledFrames(const std::vector<OrderedStampPairer<ColourDepth, ImagePtr>::Pair>& frames);
   void onSynchronized(const ImagePtr& image, const ImagePtr& depth) {
-    deliver(image, depth, nullptr);
+    deliver(image, depth, nullptr, false);
   }
   void onSynchronizedWithLabels(const ImagePtr& image, const ImagePtr& depth,
                                 const ImagePtr& labels) {
-    deliver(image, depth, labels);
+    deliver(image, depth, labels, false);
   }
-  void deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels);
+  void deliver(const ImagePtr& image, const ImagePtr& depth, const ImagePtr& labels, bool held);
   // A colour image arrived: warns when many in a row made no frame.
   void countArrival(const ros::Time& stamp);
 
