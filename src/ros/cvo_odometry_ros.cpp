@@ -32,7 +32,6 @@ CvoOdometryRos::CvoOdometryRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       pnh_(pnh),
       settings_(readNodeSettings(pnh)),
       it_(nh),
-      tf_listener_(tf_buffer_),
       queue_(settings_.node.process_every_frame) {
   pipeline_ = std::make_unique<OdometryPipeline>(
       settings_.odometry, [this](const CvoParams& params) { return makeBackend(params); });
@@ -254,8 +253,11 @@ void CvoOdometryRos::handle(const QueuedFrame& queued) {
   const PipelineResult result =
       pipeline_->process(header.stamp.toSec(), queued.frame, *base_from_camera_);
   const ros::Time now = ros::Time::now();
-  const double latency_ms = queued.far_from_clock ? std::numeric_limits<double>::quiet_NaN()
-                                                  : (now - header.stamp).toSec() * 1000.0;
+  // The clock went backwards since the frame came (a looping bag): it belongs to the loop before.
+  const bool before_clock_jump = now < queued.arrival;
+  const double latency_ms = queued.far_from_clock || before_clock_jump
+                                ? std::numeric_limits<double>::quiet_NaN()
+                                : (now - header.stamp).toSec() * 1000.0;
   if (result.outcome == FrameOutcome::kSkipped && last_stamp &&
       *last_stamp == header.stamp.toSec()) {
     diagnostics_->countSkipped(SkipReason::kRepeatedStamp, result.why);
@@ -280,11 +282,11 @@ void CvoOdometryRos::handle(const QueuedFrame& queued) {
   if (!result.update.report.warning.empty()) {
     ROS_WARN_STREAM_THROTTLE(5.0, pnh_.getNamespace() << ": " << result.update.report.warning);
   }
-  publish(header, result, latency_ms);
+  publish(header, result, latency_ms, !before_clock_jump);
 }
 
 void CvoOdometryRos::publish(const std_msgs::Header& header, const PipelineResult& result,
-                             double latency_ms) {
+                             double latency_ms, bool send_tf) {
   const NodeOptions& node = settings_.node;
   indicator_pub_.publish(
       indicatorMsg(result, header.stamp, node.odom_frame, {latency_ms, queue_.dropped()}));
@@ -293,8 +295,15 @@ void CvoOdometryRos::publish(const std_msgs::Header& header, const PipelineResul
       odometryMsg(result.update, header.stamp, node.odom_frame, node.base_frame);
   odom_pub_.publish(odom);
   diagnostics_->odometryPublished();
-  // A repeated stamp would only make listeners warn (TF_REPEATED_DATA).
-  if (node.publish_tf && header.stamp != last_tf_stamp_) {
+  // A repeated stamp would only make listeners warn (TF_REPEATED_DATA). So would a frame from
+  // before the clock went backwards: listeners clear their buffers when it does, would keep its
+  // stamp, and get the same stamp again in the next loop.
+  if (node.publish_tf && !send_tf) {
+    diagnostics_->countTfWithheld();
+    ROS_INFO_STREAM_THROTTLE(5.0, pnh_.getNamespace()
+                                      << ": the clock went backwards (a looping bag?): no TF for "
+                                         "the frames that came before it");
+  } else if (node.publish_tf && header.stamp != last_tf_stamp_) {
     tf_broadcaster_.sendTransform(odometryTransformMsg(odom));
     last_tf_stamp_ = header.stamp;
   }
@@ -376,20 +385,30 @@ Eigen::Isometry3d CvoOdometryRos::baseFromCamera(const std::string& camera_frame
     static_broadcaster_.sendTransform(stamped);
     return base_from_camera;
   }
-  try {
-    return fromTransformMsg(tf_buffer_
-                                .lookupTransform(node.base_frame, camera_frame, ros::Time(0),
-                                                 ros::Duration(node.tf_wait))
-                                .transform);
-  } catch (const tf2::TransformException& e) {
-    ROS_WARN_STREAM(pnh_.getNamespace()
-                    << ": no transform " << node.base_frame << " <- " << camera_frame << " after "
-                    << node.tf_wait << " s (" << e.what() << "); assuming a camera looking along "
-                    << node.base_frame
-                    << "'s x axis (optical frame z forward). Publish the camera's transform (e.g. "
-                       "the launch files' camera_transform argument), then call ~reset.");
-    return opticalFrameInBase();
-  }
+  // A listener for this lookup only: one kept all along would take in every /tf message, our
+  // own odometry's included, and warn at each jump of a looping bag's clock. The wait is on the
+  // wall clock: a simulated one may stand still meanwhile (a player paced by our indicator waits
+  // for this very frame).
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(node.tf_wait);
+  std::string why;
+  do {
+    try {
+      return fromTransformMsg(
+          buffer.lookupTransform(node.base_frame, camera_frame, ros::Time(0)).transform);
+    } catch (const tf2::TransformException& e) {
+      why = e.what();
+    }
+    ros::WallDuration(0.01).sleep();
+  } while (ros::WallTime::now() < deadline && ros::ok());
+  ROS_WARN_STREAM(pnh_.getNamespace()
+                  << ": no transform " << node.base_frame << " <- " << camera_frame << " after "
+                  << node.tf_wait << " s (" << why << "); assuming a camera looking along "
+                  << node.base_frame
+                  << "'s x axis (optical frame z forward). Publish the camera's transform (e.g. "
+                     "the launch files' camera_transform argument), then call ~reset.");
+  return opticalFrameInBase();
 }
 
 }  // namespace cvo

@@ -158,6 +158,7 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   } else {
     status.add("clock - stamp at arrival (s)", std::string("none yet"));
   }
+  status.add("TF withheld (frames from before the clock went back)", tf_withheld_);
   status.add("lost frames", lost_);
   status.add("recovered frames", recovered_);
   status.add("tracking restarts", restarts_);

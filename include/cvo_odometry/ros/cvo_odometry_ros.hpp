@@ -62,7 +62,9 @@ class CvoOdometryRos {
   bool checkClock(const ros::Time& stamp, const ros::Time& now);
   void work();
   void handle(const QueuedFrame& queued);
-  void publish(const std_msgs::Header& header, const PipelineResult& result, double latency_ms);
+  // `send_tf`: false for a frame from before the clock went backwards.
+  void publish(const std_msgs::Header& header, const PipelineResult& result, double latency_ms,
+               bool send_tf);
   void publishClouds(const std_msgs::Header& header, const PipelineResult& result);
   void onReconfigure(cvo_odometry::CvoOdometryConfig& config, uint32_t level);
   // The next frame starts a new trajectory with the base at `base_pose`; base <- camera is
@@ -86,8 +88,6 @@ class CvoOdometryRos {
   ros::Publisher odom_pub_, indicator_pub_, path_pub_;
   ros::Publisher current_cloud_pub_, reference_cloud_pub_, aligned_cloud_pub_;
   ros::ServiceServer reset_service_, reset_to_pose_service_, pause_service_, resume_service_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;  // camera_transform
   boost::recursive_mutex reconfigure_mutex_;

@@ -62,6 +62,11 @@ class OdometryDiagnostics {
     std::lock_guard<std::mutex> lock(mutex_);
     ++resets_;
   }
+  // A frame whose TF was not sent: it arrived before the clock went backwards (a looping bag).
+  void countTfWithheld() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++tf_withheld_;
+  }
   // The node's clock minus a frame's stamp when the frame arrived (s).
   void clockOffset(double clock_minus_stamp) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -78,7 +83,7 @@ class OdometryDiagnostics {
   SyncState sync_;
   std::mutex mutex_;
   std::size_t frames_ = 0, skipped_ = 0, stale_ = 0, paused_ = 0, resets_ = 0;
-  std::size_t lost_ = 0, recovered_ = 0, restarts_ = 0, fallbacks_ = 0;
+  std::size_t lost_ = 0, recovered_ = 0, restarts_ = 0, fallbacks_ = 0, tf_withheld_ = 0;
   std::array<std::size_t, kSkipReasons> skipped_by_reason_{};
   std::string latest_skip_;
   bool lost_now_ = false;
