@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include <ros/console.h>
 #include <boost/function.hpp>
 
 namespace cvo {
@@ -9,7 +10,7 @@ namespace cvo {
 StereoTopicSync::StereoTopicSync(ros::NodeHandle nh, image_transport::ImageTransport& it,
                                  const image_transport::TransportHints& hints,
                                  const StereoSyncOptions& options, Callback callback)
-    : callback_(std::move(callback)) {
+    : callback_(std::move(callback)), options_(options) {
   if (options.queue_size < 1) throw std::invalid_argument("queue_size must be >= 1");
   const int queue_size = options.queue_size;
   auto image = [&](const std::string& topic) {
@@ -34,7 +35,7 @@ StereoTopicSync::StereoTopicSync(ros::NodeHandle nh, image_transport::ImageTrans
   auto left = image("left/image_rect");
   // Frames that arrive but never come out of the synchronizer are counted in diagnostics.
   left->registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
-      [this](const sensor_msgs::ImageConstPtr&) { ++arrived_; }));
+      [this](const sensor_msgs::ImageConstPtr& image) { countArrival(image->header.stamp); }));
   auto left_info = info("left/camera_info");
   if (!options.with_disparity) {
     auto right = image("right/image_rect");
@@ -59,9 +60,32 @@ StereoTopicSync::StereoTopicSync(ros::NodeHandle nh, image_transport::ImageTrans
                    ros::VoidPtr(), hints);
 }
 
+void StereoTopicSync::countArrival(const ros::Time& stamp) {
+  ++arrived_;
+  // About three seconds of a 10 Hz stereo camera, or a whole queue: a partner topic is missing
+  // or its stamps do not match (diagnostics count these as "frames not synchronized").
+  const std::size_t limit =
+      std::max<std::size_t>(30, static_cast<std::size_t>(options_.queue_size));
+  if (++arrived_since_frame_ < limit) return;
+  ROS_WARN_STREAM_THROTTLE(
+      5.0, "cvo_odometry: " << arrived_since_frame_
+                            << " left images in a row made no frame (latest stamp " << stamp
+                            << "): are left/camera_info and "
+                            << (options_.with_disparity ? "disparity"
+                                                        : "right/image_rect, right/camera_info")
+                            << (options_.with_labels ? " and segmentation/image" : "")
+                            << " published, with the left image's stamp? sync_policy "
+                            << settingText(options_.policy));
+}
+
+void StereoTopicSync::deliver(const Frame& frame) {
+  arrived_since_frame_ = 0;
+  callback_(frame);
+}
+
 void StereoTopicSync::onSet(Frame frame) {
   if (!labels_) {
-    callback_(frame);
+    deliver(frame);
     return;
   }
   std::lock_guard<std::mutex> lock(labels_mutex_);
@@ -74,7 +98,7 @@ void StereoTopicSync::onLabelled(
   for (const auto& pair : frames) {
     Frame frame = pair.first;
     frame.labels = pair.second;
-    callback_(frame);
+    deliver(frame);
   }
 }
 

@@ -67,11 +67,16 @@ class StereoTopicSync {
   }
   // A synchronized set: delivered, or paired with its labels first.
   void onSet(Frame frame);
+  void deliver(const Frame& frame);
+  // A left image arrived: warns when many in a row made no frame.
+  void countArrival(const ros::Time& stamp);
   void onLabelled(
       const std::vector<OrderedStampPairer<Frame, sensor_msgs::ImageConstPtr>::Pair>& frames);
 
   Callback callback_;
+  StereoSyncOptions options_;
   std::atomic<std::size_t> arrived_{0};
+  std::atomic<std::size_t> arrived_since_frame_{0};
   // Segmentation: sets and labels paired by equal stamps, under one lock.
   std::mutex labels_mutex_;
   std::optional<OrderedStampPairer<Frame, sensor_msgs::ImageConstPtr>> labels_;
