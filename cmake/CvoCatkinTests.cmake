@@ -17,14 +17,15 @@ add_dependencies(tests ${PROJECT_NAME}_generate_messages ${PROJECT_NAME}_gencfg)
 # same suite.
 if(TARGET run_tests)
   cmake_host_system_information(RESULT CVO_TEST_JOBS QUERY NUMBER_OF_LOGICAL_CORES)
-  set(CVO_CTEST_ARGS --output-on-failure -j${CVO_TEST_JOBS})
-  if(NOT CMAKE_VERSION VERSION_LESS 3.21)
-    set(CVO_TEST_RESULTS ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME})
-    list(APPEND CVO_CTEST_ARGS --output-junit ${CVO_TEST_RESULTS}/ctest-${PROJECT_NAME}.xml)
+  set(CVO_CTEST ${CMAKE_CTEST_COMMAND} --output-on-failure -j${CVO_TEST_JOBS})
+  if(NOT CMAKE_VERSION VERSION_LESS 3.21)  # ctest --output-junit
+    set(CVO_JUNIT ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/ctest-${PROJECT_NAME}.xml)
+    set(CVO_CTEST ${PYTHON_EXECUTABLE} ${PROJECT_SOURCE_DIR}/cmake/cvo_ctest_junit.py ${CVO_JUNIT}
+                  ${CVO_CTEST} --output-junit ${CVO_JUNIT})
   endif()
   add_custom_target(run_tests_${PROJECT_NAME}_ctest
     COMMAND ${CMAKE_COMMAND} -E make_directory ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}
-    COMMAND ${CMAKE_CTEST_COMMAND} ${CVO_CTEST_ARGS}
+    COMMAND ${CVO_CTEST}
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR} USES_TERMINAL VERBATIM)
   add_dependencies(run_tests_${PROJECT_NAME}_ctest tests)
   add_dependencies(run_tests run_tests_${PROJECT_NAME}_ctest)
