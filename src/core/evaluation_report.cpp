@@ -9,7 +9,8 @@ namespace cvo {
 
 EvaluationReport evaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
                                     const EvaluationOptions& options,
-                                    const std::vector<double>* trusted_stamps) {
+                                    const std::vector<double>* trusted_stamps,
+                                    const std::vector<double>& restart_stamps) {
   EvaluationReport report;
   report.estimated_poses = estimate.size();
   const AssociatedPoses poses =
@@ -34,7 +35,7 @@ EvaluationReport evaluateTrajectory(const Trajectory& ground_truth, const Trajec
   report.drift = computeKittiDrift(poses, options.drift_lengths_m);
   if (trusted_stamps) {
     report.judged_trust = true;
-    report.silent = countSilentFailures(poses, *trusted_stamps);
+    report.silent = countSilentFailures(poses, *trusted_stamps, 0.5, 0.02, 1.0, restart_stamps);
   }
   return report;
 }

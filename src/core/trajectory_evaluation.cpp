@@ -1,5 +1,6 @@
 #include "cvo_odometry/core/trajectory_evaluation.hpp"
 
+#include <optional>
 #include <set>
 
 #include <algorithm>
@@ -172,13 +173,24 @@ DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<do
 
 SilentFailures countSilentFailures(const AssociatedPoses& poses,
                                    const std::vector<double>& trusted_stamps, double fraction,
-                                   double min_error_m, double max_rotation_deg) {
+                                   double min_error_m, double max_rotation_deg,
+                                   const std::vector<double>& restart_stamps) {
   SilentFailures result;
   const std::set<double> trusted(trusted_stamps.begin(), trusted_stamps.end());
-  for (std::size_t k = 1; k < poses.size(); ++k) {
+  const std::set<double> restarts(restart_stamps.begin(), restart_stamps.end());
+  // Each trusted frame against the trusted one before it: an untrusted pose between them is a
+  // guess that no trusted pose is measured from.
+  std::optional<std::size_t> last;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
     if (!trusted.count(poses.stamps[k])) continue;
-    const Eigen::Isometry3d truth = poses.ground_truth[k - 1].inverse() * poses.ground_truth[k];
-    const Eigen::Isometry3d step = poses.estimate[k - 1].inverse() * poses.estimate[k];
+    const std::optional<std::size_t> before = last;
+    last = k;
+    if (!before) continue;
+    const std::size_t j = *before;
+    const auto restart = restarts.upper_bound(poses.stamps[j]);
+    if (restart != restarts.end() && *restart <= poses.stamps[k]) continue;
+    const Eigen::Isometry3d truth = poses.ground_truth[j].inverse() * poses.ground_truth[k];
+    const Eigen::Isometry3d step = poses.estimate[j].inverse() * poses.estimate[k];
     const Eigen::Isometry3d error = truth.inverse() * step;
     const double t = error.translation().norm();
     const double r = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;

@@ -29,10 +29,12 @@ struct EvaluationReport {
 };
 
 // `trusted_stamps`, when given, are the frames the odometry called trusted: the report then
-// counts its silent failures.
+// counts its silent failures; `restart_stamps` the frames where tracking restarted
+// (countSilentFailures).
 EvaluationReport evaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
                                     const EvaluationOptions& options,
-                                    const std::vector<double>* trusted_stamps = nullptr);
+                                    const std::vector<double>* trusted_stamps = nullptr,
+                                    const std::vector<double>& restart_stamps = {});
 void printEvaluationReport(std::ostream& out, const EvaluationReport& report,
                            const EvaluationOptions& options);
 

@@ -68,15 +68,18 @@ DriftResult computeKittiDrift(const AssociatedPoses& poses, const std::vector<do
                               int step = 10);
 std::vector<double> kittiDriftLengths();
 
-// Frames the odometry called trusted whose motion from the previous frame is wrong: translation
-// error above both `fraction` of the ground-truth step and `min_error_m`, or rotation error
-// above `max_rotation_deg`. A "silent failure": a wrong pose reported as right.
+// Frames the odometry called trusted whose motion from the previous trusted frame is wrong:
+// translation error above both `fraction` of the ground-truth step and `min_error_m`, or
+// rotation error above `max_rotation_deg`. A "silent failure": a wrong pose reported as right.
+// A restart between two trusted frames (`restart_stamps`: tracking started anew there, which
+// the indicator says) ends a stretch: the pair across it is not judged.
 struct SilentFailures {
   std::size_t judged = 0;  // trusted frames with ground truth at them and the previous one
   std::size_t failures = 0;
 };
 SilentFailures countSilentFailures(const AssociatedPoses& poses,
                                    const std::vector<double>& trusted_stamps, double fraction = 0.5,
-                                   double min_error_m = 0.02, double max_rotation_deg = 1.0);
+                                   double min_error_m = 0.02, double max_rotation_deg = 1.0,
+                                   const std::vector<double>& restart_stamps = {});
 
 }  // namespace cvo
