@@ -93,6 +93,15 @@ void CvoParams::validate() const {
   requirePositive(track_agreement_px, "track_agreement_px");
   require(min_track_agreement >= 0.0 && min_track_agreement <= 1.0,
           "min_track_agreement must be in [0, 1]");
+  require(moving_region_px >= 0.0 && moving_region_px <= 1000.0,
+          "moving_region_px must be in [0, 1000]");
+  require(max_track_rotation_gap > 0.0 && max_track_rotation_gap <= 180.0,
+          "max_track_rotation_gap must be in (0, 180]");
+  require(motion_split_ratio >= 0.0 && motion_split_ratio <= 1.0,
+          "motion_split_ratio must be in [0, 1]");
+  require(moving_min_px >= 0.0 && moving_min_px <= 1000.0, "moving_min_px must be in [0, 1000]");
+  require(motion_split_depth_ratio >= 1.0 && motion_split_depth_ratio <= 100.0,
+          "motion_split_depth_ratio must be in [1, 100]");
   require(tracked_cosine_ratio >= 0.0 && tracked_cosine_ratio <= 1.0,
           "tracked_cosine_ratio must be in [0, 1]");
   requirePositive(photometric_max_correction, "photometric_max_correction");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/pose_covariance.hpp"
 #include "cvo_odometry/core/registration_covariance.hpp"
 #include "cvo_odometry/core/tracking_check.hpp"
@@ -16,6 +17,11 @@ namespace {
 
 // A twist covariance nobody knows (the first frame): large, as REP-105 consumers expect.
 constexpr double kUnknownVariance = 1e6;
+// An object seen moving within this long (s) may still be in view: every registration needs
+// the tracks' judgement meanwhile.
+constexpr double kMovingMemorySeconds = 2.0;
+// A split leaves at least this share of the frame's points to the scene, or is not trusted.
+constexpr double kMinSceneShare = 0.3;
 
 double angleDeg(const Eigen::Isometry3d& T) {
   return lie::rotationAngle(T.rotation()) * 180.0 / M_PI;
@@ -65,7 +71,9 @@ KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
       photometric_pool_(resolvedThreadCount(params.num_threads)) {}
 
 void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
+  moving_seen_stamp_.reset();
   reference_.reset();
+  reference_guessed_ = false;
   last_good_.reset();
   reference_first_cosine_.reset();
   reference_self_.reset();
@@ -77,6 +85,7 @@ void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   covariance_.setZero();
   reference_covariance_.setZero();
   lost_frames_ = 0;
+  frames_since_anchor_ = 0;
   started_ = false;
   start_base_pose_ = base_pose;
 }
@@ -95,6 +104,7 @@ void KeyframeOdometry::remapDepths(const std::function<float(float)>& new_depth)
   if (last_good_ && last_good_->cloud) {
     last_good_->cloud = last_good_->cloud == before ? reference_ : remapped(last_good_->cloud);
   }
+  if (last_good_ && last_good_->whole) last_good_->whole = remapped(last_good_->whole);
   // Too few points left to register to: the next frame starts from its own (as setReference).
   const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
   if (reference_ && reference_->size() < minimum) reference_.reset();
@@ -117,6 +127,19 @@ std::optional<Eigen::Isometry3d> KeyframeOdometry::constantVelocityMotion(double
                               lie::expSE3(*velocity_ * interval));
 }
 
+std::optional<Eigen::Isometry3d> KeyframeOdometry::priorFramePose(const MotionPrior& prior) const {
+  // Tracks over a longer stretch than a loss streak keep only what barely moves in the image:
+  // an object moving along with the camera, say. They judge nothing.
+  if (frames_since_anchor_ > params().max_lost_frames) return std::nullopt;
+  if (std::isnan(prior.from_stamp) || (last_stamp_ && prior.from_stamp == *last_stamp_)) {
+    // The frame before this one: tracked, or lost but placed by its own prior.
+    if (lost_frames_ == 0 || previous_placed_by_prior_) return pose_;
+    return std::nullopt;
+  }
+  if (last_good_ && prior.from_stamp == last_good_->stamp) return last_good_->pose;
+  return std::nullopt;
+}
+
 Eigen::Isometry3d KeyframeOdometry::stillMotion() const {
   return lie::orthonormalized(reference_pose_.inverse() * pose_);
 }
@@ -129,15 +152,102 @@ bool KeyframeOdometry::priorConfident(const std::optional<MotionPrior>& prior) c
   return priorJudges(prior) && prior->inlier_ratio >= params().min_prior_inlier_ratio;
 }
 
+bool KeyframeOdometry::separateSecondMotion(const std::optional<MotionPrior>& prior) const {
+  // Static scenes show second motions too, near the first: an RGB-D camera's depth is older than
+  // its colour, which moves near and far tracks apart by a pixel or two. Only one whose tracks
+  // move further apart is an object moving on its own; a slower one costs less than a silent
+  // failure's error.
+  return priorJudges(prior) && prior->second.solved &&
+         prior->second.inliers >= params().min_prior_inliers &&
+         motionsApartPx(*prior, prior->motion, prior->second.motion) >= params().moving_min_px;
+}
+
+std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
+  split_.reset();
+  if (!separateSecondMotion(frame.prior)) return "";
+  moving_seen_stamp_ = frame.stamp;
+  // The camera's last velocity predicts this step (previous <- current).
+  std::optional<Eigen::Isometry3d> predicted;
+  const double from =
+      std::isnan(frame.prior->from_stamp) && last_stamp_ ? *last_stamp_ : frame.prior->from_stamp;
+  if (velocity_ && std::isfinite(from)) predicted = lie::expSE3(*velocity_ * (frame.stamp - from));
+  split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
+                        params().motion_split_ratio, predicted);
+  if (split_->scene == SceneMotion::kUndecided) return split_->why;
+  MotionPrior scene = sceneFirst(*frame.prior, *split_);
+  std::shared_ptr<const LabeledCloud> rest = withoutRegion(frame.cloud, scene, scene.second.pixels);
+  if (frame.cloud && rest->size() < kMinSceneShare * frame.cloud->size()) {
+    // So little of the view is left that its motion is the object's as likely as not.
+    std::ostringstream why;
+    why.precision(3);
+    why << split_->why << "; but the object's region holds "
+        << 100.0 * (1.0 - static_cast<double>(rest->size()) / frame.cloud->size())
+        << " % of the frame's points";
+    split_->scene = SceneMotion::kUndecided;
+    return why.str();
+  }
+  leaveOutObjectFromReference(*frame.prior, *split_);
+  frame.prior = std::move(scene);
+  frame.cloud = std::move(rest);
+  return "";
+}
+
+std::shared_ptr<const LabeledCloud> KeyframeOdometry::withoutRegion(
+    const std::shared_ptr<const LabeledCloud>& cloud, const MotionPrior& prior,
+    const std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>>& pixels) const {
+  const double radius = params().moving_region_px;
+  if (!cloud || !prior.camera || radius <= 0.0 || prior.image_width < 1 || prior.image_height < 1) {
+    return cloud;
+  }
+  auto region = std::make_shared<PixelRegion>(prior.image_width, prior.image_height);
+  for (const Eigen::Vector2f& pixel : pixels)
+    region->addDisc(pixel.x(), pixel.y(), radius);
+  region->closeGaps(2.0 * radius);
+  const CameraModel& camera = *prior.camera;
+  const PixelRegion& inside = *region;  // the shared pointer moves into the call
+  return std::make_shared<const LabeledCloud>(cloud->without(
+      [&](const Eigen::Vector3f& point) {
+        if (!(point.z() > 0.0f)) return false;
+        const Eigen::Vector2d pixel = camera.project(point.cast<double>());
+        return inside.contains(pixel.x(), pixel.y());
+      },
+      std::move(region)));
+}
+
+void KeyframeOdometry::leaveOutObjectFromReference(const MotionPrior& prior,
+                                                   const MotionSplit& split) {
+  // Only the reference the tracks start from, and only once: a frame taken before the object
+  // was found (the first of a trajectory) still holds it.
+  const double from = std::isnan(prior.from_stamp) && last_stamp_ ? *last_stamp_ : prior.from_stamp;
+  if (!reference_ || reference_->leftOutRegion() || reference_stamp_ != from || !prior.camera) {
+    return;
+  }
+  const int object = split.scene == SceneMotion::kFirst ? 1 : 0;
+  std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> seen;
+  for (std::size_t k = 0; k < split.owner.size(); ++k) {
+    if (split.owner[k] != object) continue;
+    const Eigen::Vector3d& X = prior.tracked_points[k];
+    if (X.z() > 0.0) seen.push_back(prior.camera->project(X).cast<float>());
+  }
+  const std::shared_ptr<const LabeledCloud> before = reference_;
+  const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
+  std::shared_ptr<const LabeledCloud> without = withoutRegion(reference_, prior, seen);
+  if (without->size() < minimum) return;
+  reference_ = std::move(without);
+  reference_self_.reset();
+  if (last_good_ && last_good_->cloud == before) last_good_->cloud = reference_;
+}
+
 void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval,
                                      std::vector<Guess>* first, std::vector<Guess>* retries) const {
   const CvoParams& p = params();
   const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(interval);
   const Guess still{GuessKind::kIdentity, stillMotion()};
   const bool confident = priorConfident(frame.prior);
-  // The prior moves the camera from the previous frame's pose.
+  // The prior moves the camera from the pose of the frame its tracks start from.
   const Guess prior{GuessKind::kFeatures,
-                    confident ? lie::orthonormalized(stillMotion() * frame.prior->motion)
+                    confident ? lie::orthonormalized(reference_pose_.inverse() * prior_frame_pose_ *
+                                                     frame.prior->motion)
                               : Eigen::Isometry3d::Identity()};
   const Guess constant{GuessKind::kConstantVelocity,
                        velocity ? *velocity : Eigen::Isometry3d::Identity()};
@@ -205,8 +315,23 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   a.good = check.good;
   a.problems = check.problems;
   if (!a.good) return a;
+  if (!priorJudges(frame.prior)) {
+    // The cosine alone does not judge a registration to a lost frame (its motion may be right,
+    // but the pose is the guess's times it) nor one beside an object moving through the view
+    // (it scores a registration the object pulled like a right one): tracks must.
+    const bool moving_lately =
+        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    if (reference_guessed_ || moving_lately) {
+      a.good = false;
+      a.problems = reference_guessed_
+                       ? "no feature tracks to judge a registration to a frame placed by a guess"
+                       : "no feature tracks to judge a registration while something moves in "
+                         "view (a second motion, or registrations the tracks refused, lately)";
+      return a;
+    }
+  }
   // The tracks' points are the previous frame's: the motion over this step is prior <- current.
-  const Eigen::Isometry3d prior_from_reference = pose_.inverse() * reference_pose_;
+  const Eigen::Isometry3d prior_from_reference = prior_frame_pose_.inverse() * reference_pose_;
   const Eigen::Isometry3d registered = a.result.transform;
   // Only a registration judged good is refined: a bad one is retried or lost anyway.
   if (p.photometric_rotation) {
@@ -225,7 +350,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       }
       PhotometricRotationResult refined = refineRotationPhotometrically(
           *view.image(), *cloud.image(), cloud, view_from_reference * a.result.transform, p,
-          &photometric_pool_, &tracks);
+          &photometric_pool_, &tracks, view.leftOutRegion());
       a.result.transform = view_from_reference.inverse() * refined.transform;
       a.photometric = refined.report;
     } else {
@@ -245,7 +370,23 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     a.agreement = agreement.fraction;
     a.track_error_px = agreement.median_px;
     a.track_flow_px = agreement.median_flow_px;
-    if (a.agreement < p.min_track_agreement) {
+    // The tracks fix rotation well whatever the depth: the final pose's turn over the step
+    // against theirs.
+    a.track_rotation_gap_deg =
+        angleDeg(frame.prior->motion.inverse() * prior_from_reference * a.result.transform);
+    if (a.agreement >= p.min_track_agreement &&
+        a.track_rotation_gap_deg > p.max_track_rotation_gap) {
+      // Within the pixels the tracks allow, yet turned away from them: something in view pulled
+      // the dense stages (a moving object without tracks of its own).
+      std::ostringstream why;
+      why.precision(3);
+      why << "the pose turns " << a.track_rotation_gap_deg
+          << " deg from the feature tracks' motion > max_track_rotation_gap "
+          << p.max_track_rotation_gap;
+      a.good = false;
+      a.problems = why.str();
+      moving_seen_stamp_ = frame.stamp;
+    } else if (a.agreement < p.min_track_agreement) {
       std::ostringstream why;
       why.precision(3);
       why << "feature tracks disagree: " << 100.0 * a.agreement << " % of "
@@ -254,6 +395,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
           << " px) < min_track_agreement " << p.min_track_agreement;
       a.good = false;
       a.problems = why.str();
+      moving_seen_stamp_ = frame.stamp;
     } else if (a.photometric.tracks > 0) {
       // The stage's pose must agree with the tracks too: intensities that dragged it off them
       // (the translation has no bound of its own) give way to CVO's pose.
@@ -298,18 +440,42 @@ OdometryUpdate KeyframeOdometry::processLostFrame(double stamp, const std::strin
 OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   checkStamp(frame.stamp);
   source_self_.reset();
+  // An object moving through the view: its region is left out of everything but the judgement
+  // of a split, which needs the whole frame.
+  whole_cloud_ = frame.cloud;
   if (!started_) {
     base_from_camera_ = frame.base_from_camera;
     started_ = true;
   }
   if (params().forget_motion) velocity_.reset();
-  // The prior relates this frame to the previous one: when that was lost and placed by no
-  // prior of its own (a constant-velocity guess), its pose means nothing to the tracks.
-  if (lost_frames_ > 0 && !previous_placed_by_prior_) frame.prior.reset();
+  // The prior relates this frame to the one its tracks start from: of use only where that
+  // frame's pose means something (not a lost frame's constant-velocity guess).
+  if (frame.prior) {
+    if (const std::optional<Eigen::Isometry3d> pose = priorFramePose(*frame.prior)) {
+      prior_frame_pose_ = *pose;
+    } else {
+      frame.prior.reset();
+    }
+  }
+  const std::string split_problem = judgeSecondMotion(frame);
   if (!reference_) return startFrom(frame);
   const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
   OdometryUpdate update;
   update.stamp = frame.stamp;
+  if (frame.prior && frame.prior->second.solved) {
+    update.second_motion_tracks = frame.prior->second.inliers;
+    update.second_motion_separate = split_.has_value();
+  }
+  if (split_ && split_->scene != SceneMotion::kUndecided) {
+    update.motion_split = split_->why;
+    if (cloud && cloud->leftOutRegion()) {
+      update.moving_region = std::shared_ptr<const PixelRegion>(cloud, cloud->leftOutRegion());
+    }
+  }
+  if (cloud && whole_cloud_ && whole_cloud_->size() > 0) {
+    update.left_out_share =
+        1.0 - static_cast<double>(cloud->size()) / static_cast<double>(whole_cloud_->size());
+  }
   update.dt = frame.stamp - reference_stamp_;
   update.frame_interval = frame.stamp - *last_stamp_;
   update.reference_points = reference_->size();
@@ -320,6 +486,13 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   const TrackingCheck counts = checkPointCounts(reference_->size(), cloud->size(), params());
   if (!counts.good) {
     lose(update, frame, counts.problems);
+    return update;
+  }
+  if (!split_problem.empty()) {
+    // Which motion the scene follows is unknown: no registration can be judged, and the tracks
+    // cannot place the frame either.
+    frame.prior.reset();
+    lose(update, frame, split_problem);
     return update;
   }
   std::vector<Guess> first, retries;
@@ -358,7 +531,9 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   if (!chosen->good && last_good_ && last_good_->stamp != reference_stamp_) {
     // The keyframe is out of reach: register to the last good frame instead, which is nearer
     // (this frame then becomes the keyframe).
-    const GoodFrame keyframe{reference_, reference_stamp_, reference_pose_, reference_covariance_};
+    const GoodFrame keyframe{reference_, reference_stamp_, reference_pose_, reference_covariance_,
+                             nullptr};
+    const bool keyframe_guessed = reference_guessed_;
     const auto keyframe_self = reference_self_;
     const auto keyframe_first_cosine = reference_first_cosine_;
     setReference(*last_good_);
@@ -377,6 +552,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
     if (!chosen->good) {
       // Lost: the keyframe stays the reference.
       setReference(keyframe);
+      reference_guessed_ = keyframe_guessed;
       reference_self_ = keyframe_self;
       reference_first_cosine_ = keyframe_first_cosine;
       update.dt = frame.stamp - reference_stamp_;
@@ -391,6 +567,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   update.track_agreement = chosen->agreement;
   update.track_error_px = chosen->track_error_px;
   update.track_flow_px = chosen->track_flow_px;
+  update.track_rotation_gap_deg = chosen->track_rotation_gap_deg;
   if (!chosen->good) {
     lose(update, frame, problems);
     return update;
@@ -402,7 +579,9 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
 
 OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
+  frames_since_anchor_ = 0;
   OdometryUpdate update;
+  update.restart_tracks = true;
   update.stamp = frame.stamp;
   update.state = TrackingState::kFirstFrame;
   update.pose = pose_;
@@ -417,7 +596,7 @@ OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   setReference(cloud, frame.stamp);
   last_trusted_pose_ = pose_;  // the start of the velocity estimate
   last_trusted_stamp_ = frame.stamp;
-  if (reference_) last_good_ = GoodFrame{reference_, frame.stamp, pose_, covariance_};
+  if (reference_) last_good_ = GoodFrame{reference_, frame.stamp, pose_, covariance_, whole_cloud_};
   fillBaseFrame(update, Matrix6d::Identity() * kUnknownVariance);
   update.twist_covariance = Matrix6d::Identity() * kUnknownVariance;
   last_stamp_ = frame.stamp;
@@ -432,6 +611,7 @@ void KeyframeOdometry::setReference(const GoodFrame& frame) {
 
 void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& cloud,
                                     double stamp) {
+  reference_guessed_ = false;  // lose() says when it is
   reference_.reset();
   reference_self_.reset();
   reference_first_cosine_.reset();
@@ -470,8 +650,9 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   last_trusted_pose_ = pose_;
   last_trusted_stamp_ = update.stamp;
   lost_frames_ = 0;
+  frames_since_anchor_ = 0;
   if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;
-  last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_};
+  last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_, whole_cloud_};
   update.new_keyframe = wantsKeyframe(update);
   if (update.new_keyframe) {
     setReference(frame.cloud, update.stamp);
@@ -487,12 +668,14 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
   const CvoParams& p = params();
   update.problem = why;
   update.lost_frames = ++lost_frames_;
+  ++frames_since_anchor_;
   // The best guess there is: the feature prior when confident, else constant velocity.
   const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(update.frame_interval);
   previous_placed_by_prior_ = priorConfident(frame.prior);
-  update.motion = priorConfident(frame.prior) ? stillMotion() * frame.prior->motion
-                  : velocity                  ? *velocity
-                                              : stillMotion();
+  update.motion = priorConfident(frame.prior)
+                      ? reference_pose_.inverse() * prior_frame_pose_ * frame.prior->motion
+                  : velocity ? *velocity
+                             : stillMotion();
   const Matrix6d guessed = guessedMotionCovariance(p, update.frame_interval);
   const Eigen::Isometry3d previous = pose_;
   const bool restart =
@@ -509,23 +692,37 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // forgotten; a frame with too few points leaves no reference, so the next one starts anew.
     update.state = TrackingState::kReset;
     update.has_pose = p.lost_frame_policy != LostFramePolicy::kPublishNothing;
+    // A new stretch starts here: its reference is no guess (the silent failure count judges no
+    // pair across a restart), yet beside something moving the tracks from the last trusted
+    // frame still judge the frames after it (restart_tracks below).
     setReference(frame.cloud, update.stamp);
     update.new_keyframe = reference_ != nullptr;
     velocity_.reset();
     last_trusted_pose_ = pose_;
     last_trusted_stamp_ = update.stamp;
     lost_frames_ = 0;
+    // The tracks start again from this frame, unless something moved lately: then only tracks
+    // from the last trusted frame can tell its guessed pose from the truth, and the next frames
+    // stay untrusted until they do or the scene has been still for a while.
+    const bool moving_lately =
+        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    update.restart_tracks = !moving_lately;
+    if (update.restart_tracks) frames_since_anchor_ = 0;
     return;
   }
   update.state = TrackingState::kLost;
   update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
-  if (previous_placed_by_prior_ && frame.cloud &&
+  // Beside something moving the prior may have followed it in part: the trusted reference stays.
+  const bool moving_lately =
+      moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+  if (previous_placed_by_prior_ && !moving_lately && frame.cloud &&
       frame.cloud->size() >= static_cast<std::size_t>(p.min_tracking_points)) {
     // Placed by a confident prior: the next frame is registered to this one, one step away,
     // rather than to a reference that falls further behind with every lost frame (at 3.6 m a
     // step one lost KITTI frame used to lose the next ones on overlap, then restart). The last
     // good frame stays the fallback.
     setReference(frame.cloud, update.stamp);
+    reference_guessed_ = true;
     update.new_keyframe = reference_ != nullptr;
     return;
   }

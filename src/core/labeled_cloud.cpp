@@ -59,6 +59,21 @@ LabeledCloud LabeledCloud::withDepths(const std::function<float(float)>& new_dep
             semantic_classes_ ? semantics(i) : nullptr);
   }
   out.image_ = image_;  // each point stays on its pixel's ray
+  out.left_out_ = left_out_;
+  return out;
+}
+
+LabeledCloud LabeledCloud::without(const std::function<bool(const Eigen::Vector3f&)>& leave_out,
+                                   std::shared_ptr<const PixelRegion> region) const {
+  LabeledCloud out(has_color_, semantic_classes_);
+  out.reserve(size());
+  for (std::size_t i = 0; i < size(); ++i) {
+    if (leave_out(position(i))) continue;
+    out.add(position(i), has_color_ ? color(i) : nullptr,
+            semantic_classes_ ? semantics(i) : nullptr);
+  }
+  out.image_ = image_;
+  out.left_out_ = std::move(region);
   return out;
 }
 

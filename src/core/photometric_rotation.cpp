@@ -35,7 +35,7 @@ constexpr double kMinTrackScalePx = 0.05;
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
     const Eigen::Isometry3d& reference_from_current, const CvoParams& params, BlockPool* pool,
-    const PhotometricTracks* tracks) {
+    const PhotometricTracks* tracks, const PixelRegion* reference_left_out) {
   const auto start = std::chrono::steady_clock::now();
   PhotometricRotationResult out;
   out.transform = reference_from_current;
@@ -143,7 +143,7 @@ PhotometricRotationResult refineRotationPhotometrically(
       if (j % stride != 0) return;
       if (!(points[j].z() > 0.0)) return;
       const Eigen::Vector2d p = current.camera().project(points[j]);
-      if (!current.inside(p.x(), p.y())) return;
+      if (!current.inside(p.x(), p.y()) || !current.usable(p.x(), p.y())) return;
       own[j] = current.intensity(level, p.x(), p.y());
       if (!point_cluster.empty()) {
         point_cluster[j] = static_cast<std::size_t>(p.y() / kClusterCellPx) * cells_per_row +
@@ -158,7 +158,11 @@ PhotometricRotationResult refineRotationPhotometrically(
         const Eigen::Vector3d Y = T * points[j];
         if (!(Y.z() > 0.0)) return;
         const Eigen::Vector2d p = reference.camera().project(Y);
-        if (!reference.inside(p.x(), p.y())) return;
+        // Where the reference saw a moving or ignored class the intensities belong to it.
+        if (!reference.inside(p.x(), p.y()) || !reference.usable(p.x(), p.y()) ||
+            (reference_left_out && reference_left_out->contains(p.x(), p.y()))) {
+          return;
+        }
         const IntensitySample s = reference.sample(level, p.x(), p.y());
         // d I / d Y, then the left perturbation Y + omega x Y + v.
         const Eigen::Vector3d dI = reference.camera().pinholeJacobian(Y).transpose() *

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -40,6 +41,9 @@ void CloudBuilderOptions::validate() const {
                                 std::to_string(selector.max_points) + "] makes no sense");
   }
   if (semantic_classes < 0) throw std::invalid_argument("semantic_classes must be >= 0");
+  if (ignore_border_px < 0 || ignore_border_px > 200) {
+    throw std::invalid_argument("ignore_border_px must be in [0, 200]");
+  }
   if (image_levels < 0 || image_levels > 6) {
     throw std::invalid_argument("image_levels must be in [0, 6]");
   }
@@ -47,8 +51,17 @@ void CloudBuilderOptions::validate() const {
 
 std::shared_ptr<const IntensityImage> intensityImage(
     const cv::Mat& image, const PinholeIntrinsics& K, int levels,
-    const std::shared_ptr<FloatBufferPool>& buffers) {
+    const std::shared_ptr<FloatBufferPool>& buffers, const cv::Mat& excluded) {
   if (levels <= 0 || !CameraModel::supportsDistortion(K.distortion.size())) return nullptr;
+  std::vector<std::uint8_t> excluded_pixels;
+  if (!excluded.empty()) {
+    if (excluded.size() != image.size() || excluded.type() != CV_8UC1) {
+      throw std::invalid_argument("the excluded pixels' mask must be 8-bit, of the image's size");
+    }
+    excluded_pixels.resize(excluded.total());
+    cv::Mat pixels(excluded.rows, excluded.cols, CV_8UC1, excluded_pixels.data());
+    excluded.copyTo(pixels);
+  }
   // Each level is written straight into its own buffer: no image is allocated and copied.
   std::vector<IntensityImage::Level> out(static_cast<std::size_t>(levels));
   const auto header = [&image, &buffers](IntensityImage::Level& level) {
@@ -67,8 +80,9 @@ std::shared_ptr<const IntensityImage> intensityImage(
     cv::Mat blurred = header(level);
     cv::GaussianBlur(sharp, blurred, cv::Size(), level.blur_sigma);
   }
-  auto* built = new IntensityImage(
-      image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion), std::move(out));
+  auto* built =
+      new IntensityImage(image.cols, image.rows, CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion),
+                         std::move(out), std::move(excluded_pixels));
   if (!buffers) return std::shared_ptr<const IntensityImage>(built);
   return std::shared_ptr<const IntensityImage>(built, [buffers](IntensityImage* done) {
     for (IntensityImage::Level& level : done->releaseLevels())
@@ -135,12 +149,31 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     semantics = std::make_unique<SemanticImage>(semantics_image, options_.semantic_classes,
                                                 options_.ignore_classes);
   }
+  // Pixels of ignored classes, grown by the border: no stage uses them.
+  cv::Mat excluded;
+  if (semantics) {
+    excluded = semantics->excludedMask();
+    if (cv::countNonZero(excluded) == 0) {
+      excluded.release();
+    } else if (options_.ignore_border_px > 0) {
+      // A square: separable, and at least the border in every direction.
+      const int side = 2 * options_.ignore_border_px + 1;
+      cv::dilate(excluded, excluded,
+                 cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side)));
+    }
+  }
   cv::Mat valid;  // NaN is outside every range
   const auto [lo, hi] = floatDepthRange(options_.min_depth, options_.max_depth);
   cv::inRange(depth, lo, hi, valid);
   const int cropped = std::min(options_.crop_top_rows, depth.rows);
   valid.rowRange(0, cropped).setTo(0);
+  const bool any_in_range = cv::countNonZero(valid) > 0;
+  if (!excluded.empty()) valid.setTo(0, excluded);
   const std::size_t valid_count = static_cast<std::size_t>(cv::countNonZero(valid));
+  if (valid_count == 0 && any_in_range) {
+    throw EmptyFrameError("every pixel with depth belongs to an ignored class (ignore_classes, " +
+                          std::to_string(options_.ignore_border_px) + " px border)");
+  }
   if (valid_count == 0) {
     // Named by what emptied it: no depth at all, the crop, or the range (RGB-D depths nearer
     // than min_depth are already NaN here: the converter drops them).
@@ -184,8 +217,8 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   if (cloud.size() == 0) {
     throw EmptyFrameError("every selected pixel belongs to an ignored class");
   }
-  cloud.setImage(intensityImage(grey, intrinsics, options_.image_levels, level_buffers_));
-  if (images) *images = FrameImages{grey, depth};
+  cloud.setImage(intensityImage(grey, intrinsics, options_.image_levels, level_buffers_, excluded));
+  if (images) *images = FrameImages{grey, depth, excluded};
   local.valid_depth_pixels = valid_count;
   local.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <exception>
+#include <limits>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -24,6 +28,47 @@ constexpr std::size_t kMinTracks = 8;
 constexpr int kBackwardLevels = 1;
 // A corner's response is at least this fraction of the strongest one's (OpenCV's suggestion).
 constexpr double kCornerQuality = 0.01;
+// Fewest RANSAC inliers a PnP motion is taken with.
+constexpr std::size_t kMinPnpInliers = 6;
+
+// current <- previous from tracks (the previous frame's points, the current image's normalised
+// rays) by EPnP in RANSAC with the inlier threshold `threshold` (normalised units), refined by
+// Levenberg-Marquardt on the inliers; none when RANSAC finds too few.
+std::optional<Eigen::Isometry3d> solvePnp(const std::vector<cv::Point3f>& points,
+                                          const std::vector<cv::Point2f>& observed,
+                                          double threshold) {
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  const cv::Matx33d identity = cv::Matx33d::eye();
+  const bool solved =
+      cv::solvePnPRansac(points, observed, identity, cv::noArray(), rvec, tvec, false, 100,
+                         static_cast<float>(threshold), 0.999, inliers, cv::SOLVEPNP_EPNP);
+  if (!solved || inliers.size() < kMinPnpInliers) return std::nullopt;
+  std::vector<cv::Point3f> inlier_points;
+  std::vector<cv::Point2f> inlier_observed;
+  for (int i : inliers) {
+    inlier_points.push_back(points[static_cast<std::size_t>(i)]);
+    inlier_observed.push_back(observed[static_cast<std::size_t>(i)]);
+  }
+  cv::solvePnPRefineLM(inlier_points, inlier_observed, identity, cv::noArray(), rvec, tvec);
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Isometry3d current_from_previous = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c)
+      current_from_previous.linear()(r, c) = R(r, c);
+    current_from_previous.translation()[r] = tvec.at<double>(r);
+  }
+  return current_from_previous;
+}
+
+// The previous frame's point X, moved by current <- previous, lands within `threshold` of the
+// ray x where the current image sees it.
+bool reprojects(const Eigen::Isometry3d& current_from_previous, const Eigen::Vector3d& X,
+                const Eigen::Vector2d& x, double threshold) {
+  const Eigen::Vector3d p = current_from_previous * X;
+  return p.z() > 1e-6 && (p.head<2>() / p.z() - x).norm() <= threshold;
+}
 
 }  // namespace
 
@@ -32,7 +77,7 @@ void FeatureTrackerOptions::validate() const {
     throw std::invalid_argument("feature_corners must be >= " + std::to_string(kMinTracks));
   }
   if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
-      !(ransac_px > 0.0)) {
+      !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000) {
     throw std::invalid_argument("feature tracker options make no sense");
   }
 }
@@ -56,38 +101,65 @@ void FeatureTracker::finishSeeding() {
     failure = "an unknown error";
   }
   if (!failure.empty()) {
-    forgetCorners();
+    recycle(candidate_);
     seed_problem_ = "finding the previous frame's corners failed: " + failure;
   }
 }
 
-void FeatureTracker::forgetCorners() {
-  points_.clear();
-  pixels_.clear();
-  last_pyramid_.clear();
+void FeatureTracker::recycle(Corners& corners) {
+  if (!corners.pyramid.empty()) spare_pyramid_ = std::move(corners.pyramid);
+  corners = Corners();
+}
+
+void FeatureTracker::frameJudged(bool trusted, std::shared_ptr<const PixelRegion> moving_region) {
+  candidate_kept_ = trusted;
+  candidate_region_ = std::move(moving_region);
+}
+
+void FeatureTracker::settleCandidate() {
+  if (!candidate_pending_) return;
+  candidate_pending_ = false;
+  // An untrusted frame's corners are dropped while an anchor is left to track from.
+  if (!candidate_kept_ && !anchor_.empty()) {
+    recycle(candidate_);
+  } else {
+    recycle(anchor_);
+    anchor_ = std::move(candidate_);
+    anchor_.moving_region = std::move(candidate_region_);
+    candidate_ = Corners();
+  }
+  candidate_kept_ = true;
+  candidate_region_.reset();
 }
 
 bool FeatureTracker::seeded() {
   finishSeeding();
-  return !points_.empty();
+  settleCandidate();
+  return !anchor_.points.empty();
 }
 
 void FeatureTracker::remapDepths(const std::function<float(float)>& new_depth) {
   finishSeeding();
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < points_.size(); ++k) {
-    const float scale = rayScale(points_[k].z, new_depth);
-    if (std::isnan(scale)) continue;
-    points_[kept] = points_[k] * scale;
-    pixels_[kept++] = pixels_[k];
+  for (Corners* corners : {&anchor_, &candidate_}) {
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < corners->points.size(); ++k) {
+      const float scale = rayScale(corners->points[k].z, new_depth);
+      if (std::isnan(scale)) continue;
+      corners->points[kept] = corners->points[k] * scale;
+      corners->pixels[kept++] = corners->pixels[k];
+    }
+    corners->points.resize(kept);
+    corners->pixels.resize(kept);
   }
-  points_.resize(kept);
-  pixels_.resize(kept);
 }
 
 void FeatureTracker::reset() {
   finishSeeding();
-  forgetCorners();
+  recycle(anchor_);
+  recycle(candidate_);
+  candidate_pending_ = false;
+  candidate_kept_ = true;
+  candidate_region_.reset();
   seed_problem_.clear();
   seed_ms_ = 0.0;
   has_previous_ = false;
@@ -107,26 +179,32 @@ std::vector<cv::Mat> FeatureTracker::pyramid(const cv::Mat& grey,
 
 void FeatureTracker::seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& K,
                           int crop_top_rows, std::vector<cv::Mat> levels) {
-  last_pyramid_ = std::move(levels);
+  candidate_.pyramid = std::move(levels);
   if (grey.empty() || depth.size() != grey.size() || depth.type() != CV_32FC1) return;
   // Only the rows below the crop, with depth, can hold a corner (KITTI: a quarter of the image
   // skipped); the measure reads the rows above them.
-  const std::vector<cv::Point2f>& corners = corners_.find(
-      grey, depth, crop_top_rows, options_.max_corners, kCornerQuality, options_.min_distance);
+  const std::vector<cv::Point2f>& corners =
+      corners_.find(grey, depth, crop_top_rows, options_.max_corners, kCornerQuality,
+                    options_.min_distance, options_.grid_columns);
   const std::vector<cv::Point2f> rays = normalisedRays(corners, K);
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const float z = depth.at<float>(cvRound(corners[k].y), cvRound(corners[k].x));
     if (!std::isfinite(z) || !(z > 0.0f)) continue;
-    points_.emplace_back(rays[k].x * z, rays[k].y * z, z);
-    pixels_.push_back(corners[k]);
+    candidate_.points.emplace_back(rays[k].x * z, rays[k].y * z, z);
+    candidate_.pixels.push_back(corners[k]);
   }
 }
 
 MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
-                                  const PinholeIntrinsics& K, int crop_top_rows) {
+                                  const PinholeIntrinsics& K, int crop_top_rows,
+                                  const cv::Mat& excluded, double stamp) {
   finishSeeding();
+  settleCandidate();
+  if (!excluded.empty() && (excluded.size() != grey.size() || excluded.type() != CV_8UC1)) {
+    throw std::invalid_argument("the excluded pixels' mask must be 8-bit, of the image's size");
+  }
   try {
-    return trackAndSeed(grey, depth, K, crop_top_rows);
+    return trackAndSeed(grey, depth, K, crop_top_rows, excluded, stamp);
   } catch (...) {
     // The next frame must not be tracked from an older one: start over from it.
     reset();
@@ -135,27 +213,33 @@ MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
 }
 
 MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
-                                         const PinholeIntrinsics& K, int crop_top_rows) {
+                                         const PinholeIntrinsics& K, int crop_top_rows,
+                                         const cv::Mat& excluded, double stamp) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<cv::Mat> current = pyramid(grey, std::move(spare_pyramid_));
-  MotionPrior prior =
-      points_.empty() || last_pyramid_.empty() ? MotionPrior{} : solve(current, grey.size(), K);
-  if (points_.empty()) {
+  MotionPrior prior = anchor_.empty() ? MotionPrior{} : solve(current, grey.size(), K, excluded);
+  prior.from_stamp = anchor_.stamp;
+  if (anchor_.points.empty()) {
     prior.problem =
         seed_problem_.empty() ? "no corners of a previous frame to track" : seed_problem_;
   }
   prior.seed_ms = seed_ms_;
   seed_problem_.clear();
   seed_ms_ = 0.0;
-  // This frame's corners replace the previous frame's; none if the search cannot even start.
-  // The previous pyramid is no longer read by anyone (the corner search is finished).
-  spare_pyramid_ = std::move(last_pyramid_);
-  forgetCorners();
+  // This frame's corners are found into the candidate, which frameJudged() settles; none if
+  // the search cannot even start.
+  candidate_ = Corners();
+  candidate_.stamp = stamp;
+  candidate_pending_ = true;
+  candidate_kept_ = true;
+  candidate_region_.reset();
   has_previous_ = true;
   // Copies, into the buffers of the last ones (the search for them is finished): the caller may
   // reuse its images once this returns.
   grey.copyTo(seed_grey_);
   depth.copyTo(seed_depth_);
+  // No corner where no stage may look: the search takes corners only where depth is.
+  if (!excluded.empty()) seed_depth_.setTo(std::numeric_limits<float>::quiet_NaN(), excluded);
   seeding_ = std::async(std::launch::async, [this, K, crop_top_rows,
                                              levels = std::move(current)]() mutable {
     const auto begin = std::chrono::steady_clock::now();
@@ -169,34 +253,43 @@ MotionPrior FeatureTracker::trackAndSeed(const cv::Mat& grey, const cv::Mat& dep
 }
 
 MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv::Size& size,
-                                  const PinholeIntrinsics& K) const {
+                                  const PinholeIntrinsics& K, const cv::Mat& excluded) const {
   MotionPrior prior;
   const cv::Size window(options_.window, options_.window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   std::vector<cv::Point2f> forward, backward;
   std::vector<unsigned char> ok_forward, ok_backward;
   std::vector<float> errors;
-  cv::calcOpticalFlowPyrLK(last_pyramid_, current, pixels_, forward, ok_forward, errors, window,
+  const std::vector<cv::Point2f>& seen = anchor_.pixels;
+  cv::calcOpticalFlowPyrLK(anchor_.pyramid, current, seen, forward, ok_forward, errors, window,
                            options_.levels, stop);
-  backward = pixels_;
+  backward = seen;
   // The check starts at home (the initial flow): a right track has nothing to search for, so
   // one level above the image will do; a wrong one still moves away or fails, and RANSAC's
   // inliers judge what passes. 0.4x the cost of all levels (TUM 2.1 -> 0.9 ms, KITTI 3.8 ->
   // 1.4 ms a frame), the prior alone as accurate (README "Large motions").
-  cv::calcOpticalFlowPyrLK(current, last_pyramid_, forward, backward, ok_backward, errors, window,
+  cv::calcOpticalFlowPyrLK(current, anchor_.pyramid, forward, backward, ok_backward, errors, window,
                            std::min(options_.levels, kBackwardLevels), stop,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   std::vector<cv::Point3f> points;
   std::vector<cv::Point2f> pixels;
-  for (std::size_t k = 0; k < pixels_.size(); ++k) {
+  std::vector<bool> on_object;  // seen on the moving object in the previous frame
+  for (std::size_t k = 0; k < seen.size(); ++k) {
     const cv::Point2f& p = forward[k];
     const bool inside = p.x >= 0 && p.y >= 0 && p.x < size.width && p.y < size.height;
     if (!ok_forward[k] || !ok_backward[k] || !inside ||
-        cv::norm(backward[k] - pixels_[k]) > options_.max_flow_error) {
+        cv::norm(backward[k] - seen[k]) > options_.max_flow_error) {
       continue;
     }
-    points.push_back(points_[k]);
+    // A corner that went behind an excluded object is not seen any more.
+    if (!excluded.empty() && excluded.at<std::uint8_t>(cvRound(std::min(p.y, size.height - 1.0f)),
+                                                       cvRound(std::min(p.x, size.width - 1.0f)))) {
+      continue;
+    }
+    points.push_back(anchor_.points[k]);
     pixels.push_back(p);
+    on_object.push_back(anchor_.moving_region &&
+                        anchor_.moving_region->contains(seen[k].x, seen[k].y));
   }
   prior.tracks = static_cast<int>(points.size());
   if (points.size() < kMinTracks) {
@@ -206,31 +299,28 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   const std::vector<cv::Point2f> observed = normalisedRays(pixels, K);
   const double focal = 0.5 * (K.fx + K.fy);
   const double threshold = options_.ransac_px / focal;
-  cv::Mat rvec, tvec;
-  std::vector<int> inliers;
-  const cv::Matx33d identity = cv::Matx33d::eye();
-  const bool solved =
-      cv::solvePnPRansac(points, observed, identity, cv::noArray(), rvec, tvec, false, 100,
-                         static_cast<float>(threshold), 0.999, inliers, cv::SOLVEPNP_EPNP);
-  if (!solved || inliers.size() < 6) {
+  // With the object's corners known from the last frame, the first motion is solved from the
+  // scene's alone (while enough of them are left).
+  const auto scene_tracks =
+      static_cast<std::size_t>(std::count(on_object.begin(), on_object.end(), false));
+  const bool separate = scene_tracks >= kMinTracks && scene_tracks < points.size();
+  std::optional<Eigen::Isometry3d> first;
+  if (separate) {
+    std::vector<cv::Point3f> scene_points;
+    std::vector<cv::Point2f> scene_observed;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (on_object[k]) continue;
+      scene_points.push_back(points[k]);
+      scene_observed.push_back(observed[k]);
+    }
+    first = solvePnp(scene_points, scene_observed, threshold);
+  }
+  if (!first) first = solvePnp(points, observed, threshold);
+  if (!first) {
     prior.problem = "PnP found no consistent motion";
     return prior;
   }
-  std::vector<cv::Point3f> inlier_points;
-  std::vector<cv::Point2f> inlier_observed;
-  for (int i : inliers) {
-    inlier_points.push_back(points[static_cast<std::size_t>(i)]);
-    inlier_observed.push_back(observed[static_cast<std::size_t>(i)]);
-  }
-  cv::solvePnPRefineLM(inlier_points, inlier_observed, identity, cv::noArray(), rvec, tvec);
-  cv::Matx33d R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Isometry3d current_from_previous = Eigen::Isometry3d::Identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c)
-      current_from_previous.linear()(r, c) = R(r, c);
-    current_from_previous.translation()[r] = tvec.at<double>(r);
-  }
+  const Eigen::Isometry3d& current_from_previous = *first;
   if (!current_from_previous.matrix().allFinite()) {
     prior.problem = "PnP gave no finite motion";
     return prior;
@@ -238,21 +328,53 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   prior.solved = true;
   prior.motion = current_from_previous.inverse();
   prior.focal_px = focal;
+  prior.inlier_px = options_.ransac_px;
+  prior.image_width = size.width;
+  prior.image_height = size.height;
+  if (CameraModel::supportsDistortion(K.distortion.size())) {
+    prior.camera = CameraModel(K.fx, K.fy, K.cx, K.cy, K.distortion);
+  }
   // The inliers of the refined motion are the tracks that judge CVO.
   prior.tracked_points.reserve(points.size());
   prior.tracked_observations.reserve(points.size());
+  std::vector<cv::Point3f> rest_points;
+  std::vector<cv::Point2f> rest_observed, rest_pixels;
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
     const Eigen::Vector2d x(observed[k].x, observed[k].y);
     prior.tracked_points.push_back(X);
     prior.tracked_observations.push_back(x);
-    const Eigen::Vector3d p = current_from_previous * X;
-    if (!(p.z() > 1e-6) || (p.head<2>() / p.z() - x).norm() > threshold) continue;
+    prior.tracked_pixels.emplace_back(pixels[k].x, pixels[k].y);
+    if ((separate && on_object[k]) || !reprojects(current_from_previous, X, x, threshold)) {
+      rest_points.push_back(points[k]);
+      rest_observed.push_back(observed[k]);
+      rest_pixels.push_back(pixels[k]);
+      continue;
+    }
     prior.points.push_back(X);
     prior.observations.push_back(x);
+    prior.inlier_pixels.emplace_back(pixels[k].x, pixels[k].y);
   }
   prior.inliers = static_cast<int>(prior.points.size());
   prior.inlier_ratio = static_cast<double>(prior.inliers) / static_cast<double>(points.size());
+  // The tracks it leaves out may follow one motion of their own: an object moving through the
+  // view. Its motion and its tracks' pixels let the odometry judge which one the scene follows
+  // and leave the other's region out.
+  if (rest_points.size() < kMinTracks) return prior;
+  const std::optional<Eigen::Isometry3d> second = solvePnp(rest_points, rest_observed, threshold);
+  if (!second || !second->matrix().allFinite()) return prior;
+  MotionPrior::SecondMotion& out = prior.second;
+  for (std::size_t k = 0; k < rest_points.size(); ++k) {
+    const Eigen::Vector3d X(rest_points[k].x, rest_points[k].y, rest_points[k].z);
+    if (!reprojects(*second, X, Eigen::Vector2d(rest_observed[k].x, rest_observed[k].y),
+                    threshold)) {
+      continue;
+    }
+    out.pixels.emplace_back(rest_pixels[k].x, rest_pixels[k].y);
+  }
+  out.inliers = static_cast<int>(out.pixels.size());
+  out.solved = out.pixels.size() >= kMinPnpInliers;
+  out.motion = second->inverse();
   return prior;
 }
 

@@ -9,6 +9,10 @@ namespace cvo {
 
 namespace {
 
+// With spreading cells, a cell's corners need at least this fraction of the bar the image's
+// strongest response sets (quality times it): a plain cell gives no corners of noise.
+constexpr double kCellQualityFloor = 0.1;
+
 // OpenCV's default border (BORDER_REFLECT_101): -1 -> 1, n -> n - 2.
 int reflect(int i, int n) {
   return i < 0 ? -i : i >= n ? 2 * n - 2 - i : i;
@@ -90,7 +94,8 @@ void MinEigenCorners::responseRow(int row, int above, int below) {
 
 const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const cv::Mat& depth,
                                                       int first_row, int max_corners,
-                                                      double quality, double min_distance) {
+                                                      double quality, double min_distance,
+                                                      int grid_columns) {
   if (grey.type() != CV_8UC1 || depth.type() != CV_32FC1 || depth.size() != grey.size()) {
     throw std::invalid_argument("corners: an 8-bit grey image and a float depth of its size");
   }
@@ -136,6 +141,32 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
   float strongest;
   std::memcpy(&strongest, &strongest_bits, sizeof strongest);
   const auto threshold = static_cast<float>(strongest * quality);
+  // Spreading cells: square, grid_columns across the image, rows below first_row. Each cell's
+  // corners are judged by its own strongest response (a high-contrast object elsewhere must not
+  // lift the bar above a plainer background), but never below kCellQualityFloor of the image's.
+  int bucket_side = 0, bucket_columns = 0, bucket_cap = 0;
+  if (grid_columns > 0 && max_corners > 0) {
+    bucket_side = std::max(1, (w + grid_columns - 1) / grid_columns);
+    bucket_columns = (w + bucket_side - 1) / bucket_side;
+    const int bucket_rows = (h - first_row + bucket_side - 1) / bucket_side;
+    const int buckets = std::max(1, bucket_columns * bucket_rows);
+    bucket_cap = std::max(1, (max_corners + buckets - 1) / buckets);
+    bucket_counts_.assign(static_cast<std::size_t>(buckets), 0);
+    bucket_threshold_.assign(static_cast<std::size_t>(buckets), 0.0f);
+    for (int y = first_row; y < h; ++y) {
+      const float* r = response_.ptr<float>(y);
+      const float* z = depth.ptr<float>(y);
+      float* cell_max = &bucket_threshold_[static_cast<std::size_t>((y - first_row) / bucket_side) *
+                                           bucket_columns];
+      for (int x = 0; x < w; ++x) {
+        if (z[x] == z[x]) cell_max[x / bucket_side] = std::max(cell_max[x / bucket_side], r[x]);
+      }
+    }
+    const auto floor = static_cast<float>(strongest * quality * kCellQualityFloor);
+    for (float& t : bucket_threshold_)
+      t = std::max(static_cast<float>(t * quality), floor);
+    row_threshold_.resize(static_cast<std::size_t>(w));
+  }
   candidates_.clear();
   is_peak_.resize(static_cast<std::size_t>(w));
   for (int y = std::max(first_row, 1); y + 1 < h; ++y) {
@@ -144,12 +175,21 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     const float* __restrict below = response_.ptr<float>(y + 1);
     const float* __restrict z = depth.ptr<float>(y);
     std::uint8_t* __restrict peak = is_peak_.data();
+    const float* __restrict bar = nullptr;
+    if (bucket_side > 0) {
+      const float* cell =
+          &bucket_threshold_[static_cast<std::size_t>((y - first_row) / bucket_side) *
+                             bucket_columns];
+      for (int x = 0; x < w; ++x)
+        row_threshold_[static_cast<std::size_t>(x)] = cell[x / bucket_side];
+      bar = row_threshold_.data();
+    }
     // Branch-free (it vectorises): above the threshold, with depth, no neighbour stronger.
     for (int x = 1; x + 1 < w; ++x) {
       const float v = r[x];
-      peak[x] = (v > threshold) & (z[x] == z[x]) & (v >= r[x - 1]) & (v >= r[x + 1]) &
-                (v >= above[x - 1]) & (v >= above[x]) & (v >= above[x + 1]) & (v >= below[x - 1]) &
-                (v >= below[x]) & (v >= below[x + 1]);
+      peak[x] = (v > (bar ? bar[x] : threshold)) & (z[x] == z[x]) & (v >= r[x - 1]) &
+                (v >= r[x + 1]) & (v >= above[x - 1]) & (v >= above[x]) & (v >= above[x + 1]) &
+                (v >= below[x - 1]) & (v >= below[x]) & (v >= below[x + 1]);
     }
     for (int x = 1; x + 1 < w;) {
       std::uint64_t eight;  // most pixels are no peak: skip them eight at a time
@@ -171,10 +211,22 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
   const auto room = [&] {
     return max_corners <= 0 || corners_.size() < static_cast<std::size_t>(max_corners);
   };
+  // False when the corner's spreading cell is full; else counts it there.
+  const auto admitted = [&](int x, int y) {
+    if (bucket_side == 0) return true;
+    int& count =
+        bucket_counts_[static_cast<std::size_t>((y - first_row) / bucket_side) * bucket_columns +
+                       x / bucket_side];
+    if (count >= bucket_cap) return false;
+    ++count;
+    return true;
+  };
   if (min_distance < 1.0) {
     for (std::size_t k = 0; k < candidates_.size() && room(); ++k) {
       const auto index = candidates_[k].second;
-      corners_.emplace_back(static_cast<float>(index % w), static_cast<float>(index / w));
+      const auto x = static_cast<int>(index % w), y = static_cast<int>(index / w);
+      if (!admitted(x, y)) continue;
+      corners_.emplace_back(static_cast<float>(x), static_cast<float>(y));
     }
     return corners_;
   }
@@ -207,7 +259,7 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
         }
       }
     }
-    if (!far_enough) continue;
+    if (!far_enough || !admitted(x, y)) continue;
     const cv::Point2f corner(static_cast<float>(x), static_cast<float>(y));
     cells_[static_cast<std::size_t>(cy) * grid_w + cx].push_back(corner);
     corners_.push_back(corner);

@@ -194,8 +194,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   } else {
     // From the second frame on, the prior (solved, or why not) relates this frame to the last.
     const bool tracked = tracker_->hasPreviousFrame();
-    MotionPrior prior =
-        tracker_->track(images.grey, images.depth, intrinsics, settings_.cloud.crop_top_rows);
+    MotionPrior prior = tracker_->track(images.grey, images.depth, intrinsics,
+                                        settings_.cloud.crop_top_rows, images.excluded, stamp);
     if (tracked) input.prior = result.prior = std::move(prior);
   }
   const auto* stereo = std::get_if<StereoFrame>(&frame);
@@ -208,6 +208,12 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     result.outcome = FrameOutcome::kSkipped;
     result.why = std::string("registration rejected the frame: ") + e.what();
     return result;
+  }
+  // The next frame is tracked from the last trusted one, telling apart the corners of an object
+  // the odometry found moving in it.
+  if (tracker_->hasPreviousFrame()) {
+    tracker_->frameJudged(result.update.trusted() || result.update.restart_tracks,
+                          result.update.moving_region);
   }
   advancePriorPose(result);
   if (stereo) {

@@ -1,7 +1,10 @@
 #include "cvo_odometry/frontend/semantic_image.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
+
+#include <opencv2/core.hpp>
 
 namespace cvo {
 
@@ -21,6 +24,31 @@ SemanticImage::SemanticImage(const cv::Mat& image, int classes, const std::vecto
 
 bool SemanticImage::ignored(int cls) const {
   return std::find(ignore_.begin(), ignore_.end(), cls) != ignore_.end();
+}
+
+cv::Mat SemanticImage::excludedMask() const {
+  cv::Mat mask(image_.size(), CV_8UC1);
+  if (image_.depth() == CV_8U) {
+    cv::Mat table(1, 256, CV_8UC1);
+    for (int id = 0; id < 256; ++id)
+      table.at<std::uint8_t>(id) = id >= classes_ || ignored(id) ? 255 : 0;
+    cv::LUT(image_, table, mask);
+    return mask;
+  }
+  for (int v = 0; v < image_.rows; ++v) {
+    std::uint8_t* out = mask.ptr<std::uint8_t>(v);
+    for (int u = 0; u < image_.cols; ++u) {
+      int cls;
+      if (image_.depth() == CV_32F) {
+        const float* p = image_.ptr<float>(v) + static_cast<std::size_t>(classes_) * u;
+        cls = static_cast<int>(std::max_element(p, p + classes_) - p);
+      } else {
+        cls = image_.at<std::uint16_t>(v, u);
+      }
+      out[u] = cls >= classes_ || ignored(cls) ? 255 : 0;
+    }
+  }
+  return mask;
 }
 
 bool SemanticImage::probabilities(int u, int v, float* out) const {

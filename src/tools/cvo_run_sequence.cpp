@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     cvo::TrackingTally tally;
     DepthRange depths;
-    std::vector<double> trusted;
+    std::vector<double> trusted, restarts;
     std::optional<cvo::DisparityOffsetEstimate> offset_estimate;  // stereo self-calibration
     std::optional<std::size_t> offset_changed_at;  // the first frame built with another offset
     double offset_in_use = settings.disparity_offset;
@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
       if (result.outcome == cvo::FrameOutcome::kProcessed) {
         if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
         if (update.has_pose && update.trusted()) trusted.push_back(input.stamps[k]);
+        if (update.state == cvo::TrackingState::kReset) restarts.push_back(input.stamps[k]);
         if (result.prior_pose) prior_trajectory.append(input.stamps[k], *result.prior_pose);
         if (result.prior) {
           timer.add("feature prior", result.prior->time_ms);
@@ -177,10 +178,17 @@ int main(int argc, char** argv) {
                     << std::fixed << update.report.time_ms << " ms (frame " << result.total_ms
                     << " ms), cosine " << std::setprecision(3) << update.cosine << ", guess "
                     << cvo::toString(update.guess) << ", tracks "
-                    << (result.prior ? result.prior->inliers : 0) << " agree "
+                    << (result.prior ? result.prior->inliers : 0) << "/"
+                    << (result.prior ? result.prior->tracks : 0) << " agree "
                     << update.track_agreement << " (median " << update.track_error_px << " px of "
-                    << update.track_flow_px << " px), "
-                    << (update.report.converged ? "converged" : update.report.message);
+                    << update.track_flow_px << " px, turn " << update.track_rotation_gap_deg
+                    << " deg), " << (update.report.converged ? "converged" : update.report.message);
+        }
+        if (update.second_motion_tracks > 0) {
+          std::cerr << ", second motion " << update.second_motion_tracks << " tracks"
+                    << (update.second_motion_separate ? " (its own: " : " (")
+                    << std::setprecision(1) << 100.0 * update.left_out_share << " % left out)";
+          if (!update.motion_split.empty()) std::cerr << " [" << update.motion_split << "]";
         }
         if (update.state != cvo::TrackingState::kTracking) {
           std::cerr << ", " << cvo::toString(update.state);
@@ -246,7 +254,8 @@ int main(int argc, char** argv) {
             gt_path, gt_format, gt_format == cvo::TrajectoryFormat::kKitti ? input.times_path : "");
       }
       const cvo::EvaluationOptions options = cvo::evaluationOptionsFrom(cli);
-      const auto report = cvo::evaluateTrajectory(ground_truth, trajectory, options, &trusted);
+      const auto report =
+          cvo::evaluateTrajectory(ground_truth, trajectory, options, &trusted, restarts);
       cvo::printEvaluationReport(std::cout, report, options);
       if (prior_trajectory.size() >= 2) {
         std::cout << "feature prior alone (KLT + PnP frame to frame), for comparison:\n";

@@ -151,9 +151,24 @@ struct CvoParams {
   // least min_track_agreement of its inliers within track_agreement_px. Only a confident one
   // (min_prior_inlier_ratio too) is a guess and relaxes the cosine.
   double track_agreement_px = 10.0;
-  double min_track_agreement = 0.5;
+  double min_track_agreement = 0.75;
+  // ... and its turn over the step within this of the prior's (deg): tracks fix rotation well at
+  // any depth (static fixtures: at most 0.22 deg apart), and a pose turned further was pulled by
+  // something the tracks do not follow.
+  double max_track_rotation_gap = 0.5;
   // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.
   double tracked_cosine_ratio = 0.25;
+  // An object moving through the view shows as a second motion among the tracks (MotionPrior::
+  // second). One of min_prior_inliers tracks that moves them at least moving_min_px from where
+  // the first puts them is a motion of its own: the scene is the farther tracks' motion when
+  // their median depth is motion_split_depth_ratio times the other's, else the one with more
+  // tracks when the other has less than motion_split_ratio times as many (motion_split.hpp has
+  // the rest; undecided, the frame is not trusted); the other's region, within
+  // moving_region_px of its tracks, is left out of the cloud and the photometric stage.
+  double moving_min_px = 4.0;
+  double moving_region_px = 24.0;
+  double motion_split_ratio = 0.3;
+  double motion_split_depth_ratio = 1.2;
 
   // Throws std::invalid_argument naming the first parameter that makes no sense.
   void validate() const;

@@ -178,11 +178,36 @@ void visitSettings(CvoParams& p, V&& v) {
                 "a registration the tracks judge is trusted only if this fraction of them agrees",
                 0.0, 1.0},
     p.min_track_agreement);
+  v(SettingInfo{"max_track_rotation_gap", "tracking",
+                "a registration the tracks judge is trusted only if it turns within this (deg) of "
+                "their motion over the step",
+                0.001, 180.0},
+    p.max_track_rotation_gap);
   v(SettingInfo{"tracked_cosine_ratio", "tracking",
                 "a registration the tracks judge needs a cosine of only this fraction of "
                 "min_cosine",
                 0.0, 1.0},
     p.tracked_cosine_ratio);
+  v(SettingInfo{"moving_min_px", "moving",
+                "a second motion among the tracks that moves them at least this far (px) from "
+                "where the first puts them is an object moving on its own",
+                0.0, 1000.0},
+    p.moving_min_px);
+  v(SettingInfo{"moving_region_px", "moving",
+                "points within this distance (px) of the tracks of a second motion (an object "
+                "moving through the view) are left out of the cloud and the photometric stage",
+                0.0, 1000.0},
+    p.moving_region_px);
+  v(SettingInfo{"motion_split_ratio", "moving",
+                "of two motions among the tracks at similar depths the scene follows the one with "
+                "more tracks when the other has fewer than this fraction of them",
+                0.0, 1.0},
+    p.motion_split_ratio);
+  v(SettingInfo{"motion_split_depth_ratio", "moving",
+                "of two motions among the tracks the scene follows the farther one's when its "
+                "tracks' median depth is this many times the other's",
+                1.0, 100.0},
+    p.motion_split_depth_ratio);
 }
 
 }  // namespace cvo

@@ -6,6 +6,7 @@
 // owns OpenCV); the core only samples it.
 #pragma once
 
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -25,7 +26,10 @@ class IntensityImage {
   };
 
   // Throws std::invalid_argument for an empty size, no level, or a level of the wrong size.
-  IntensityImage(int width, int height, const CameraModel& camera, std::vector<Level> levels);
+  // `excluded` (row-major, non-zero where a pixel must not be used: a moving or ignored class)
+  // is empty when every pixel may be used, else one byte a pixel.
+  IntensityImage(int width, int height, const CameraModel& camera, std::vector<Level> levels,
+                 std::vector<std::uint8_t> excluded = {});
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -37,6 +41,12 @@ class IntensityImage {
   bool inside(double u, double v) const {
     return u >= 1.0 && v >= 1.0 && u <= width_ - 2.0 && v <= height_ - 2.0;
   }
+  // False where the pixel nearest (u, v) is excluded; requires inside(u, v).
+  bool usable(double u, double v) const {
+    return excluded_.empty() || excluded_[static_cast<std::size_t>(v + 0.5) * width_ +
+                                          static_cast<std::size_t>(u + 0.5)] == 0;
+  }
+  bool hasExcludedPixels() const { return !excluded_.empty(); }
   // Bilinear intensity and gradients (per pixel) at (u, v); requires inside(u, v). A border
   // pixel of the 2x2 (weight 0 within inside()) gets a zero gradient: no read beyond the image.
   IntensitySample sample(int level, double u, double v) const;
@@ -51,6 +61,7 @@ class IntensityImage {
   int width_, height_;
   CameraModel camera_;
   std::vector<Level> levels_;
+  std::vector<std::uint8_t> excluded_;
 };
 
 }  // namespace cvo

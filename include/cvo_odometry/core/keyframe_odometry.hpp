@@ -23,6 +23,7 @@
 #include "cvo_odometry/core/block_pool.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/motion_prior.hpp"
+#include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/photometric_rotation.hpp"
 
 namespace cvo {
@@ -67,11 +68,24 @@ struct OdometryUpdate {
   int lost_frames = 0;            // consecutive lost frames up to and including this one
   std::string problem;            // why a registration was judged bad (also after a recovery)
   std::size_t reference_points = 0;
-  bool new_keyframe = false;           // this frame is the reference from now on
-  GuessKind guess = GuessKind::kNone;  // of the registration used
-  double track_agreement = -1.0;       // of the registration used; -1: not judged
-  double track_error_px = -1.0;        // its median reprojection error of the prior's inliers
-  double track_flow_px = -1.0;         // their median image motion over the step
+  bool new_keyframe = false;             // this frame is the reference from now on
+  GuessKind guess = GuessKind::kNone;    // of the registration used
+  double track_agreement = -1.0;         // of the registration used; -1: not judged
+  double track_error_px = -1.0;          // its median reprojection error of the prior's inliers
+  double track_flow_px = -1.0;           // their median image motion over the step
+  double track_rotation_gap_deg = -1.0;  // the pose's turn over the step against the tracks'
+  // A second motion among the tracks (an object moving through the view): its inlier tracks (0:
+  // none), whether the frame's registration from it stayed there (a motion of its own), and the
+  // share of the frame's cloud left out as its region.
+  int second_motion_tracks = 0;
+  bool second_motion_separate = false;
+  double left_out_share = 0.0;
+  std::string motion_split;  // how the scene's motion was told from the object's, if it was
+  // The object's region in this frame's image (left out of its cloud), or null.
+  std::shared_ptr<const PixelRegion> moving_region;
+  // The next frame's feature tracks start from this one: a trusted frame, or a restart while
+  // nothing moved lately (FeatureTracker::frameJudged). Else from the last such frame.
+  bool restart_tracks = false;
   // In the base frame (REP-105: odom <- base_link), base = base_from_camera of the trajectory.
   Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d base_frame_motion = Eigen::Isometry3d::Identity();  // previous <- current
@@ -127,6 +141,7 @@ class KeyframeOdometry {
     double agreement = -1.0;
     double track_error_px = -1.0;
     double track_flow_px = -1.0;
+    double track_rotation_gap_deg = -1.0;
     std::string problems;
     bool good = false;
   };
@@ -140,6 +155,9 @@ class KeyframeOdometry {
     double stamp = 0.0;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     Matrix6d covariance = Matrix6d::Zero();
+    // Its cloud before a moving object's region was left out: the fair ground on which a split
+    // between two motions is judged.
+    std::shared_ptr<const LabeledCloud> whole;
   };
   Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
                   double dt);
@@ -147,6 +165,21 @@ class KeyframeOdometry {
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
                      std::vector<Guess>* retries) const;
   bool priorConfident(const std::optional<MotionPrior>& prior) const;
+  // The prior's second motion is an object moving on its own: min_prior_inliers tracks, and
+  // its motion moves the tracks at least moving_min_px from where the first puts them.
+  bool separateSecondMotion(const std::optional<MotionPrior>& prior) const;
+  // `cloud` without the points within moving_region_px of `pixels` (an object's tracks, in the
+  // image of the prior's camera), which it keeps as its left-out region.
+  std::shared_ptr<const LabeledCloud> withoutRegion(
+      const std::shared_ptr<const LabeledCloud>& cloud, const MotionPrior& prior,
+      const std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>>& pixels) const;
+  // The object's region left out of the reference too, where it is the frame the prior's
+  // tracks start from and still whole.
+  void leaveOutObjectFromReference(const MotionPrior& prior, const MotionSplit& split);
+  // The prior's second motion checked and, when it is an object moving on its own, the scene's
+  // motion made the prior's first and the object's region left out of the frame's cloud. Why the
+  // frame cannot be trusted (which motion the scene follows is unknown), or empty.
+  std::string judgeSecondMotion(OdometryFrame& frame);
   // Enough inliers to contradict a registration, even at a ratio too low to be a guess.
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
@@ -157,6 +190,8 @@ class KeyframeOdometry {
   // reference <- current if the camera kept its velocity since the previous frame.
   std::optional<Eigen::Isometry3d> constantVelocityMotion(double interval) const;
   Eigen::Isometry3d stillMotion() const;  // reference <- previous frame
+  // start <- the frame the prior's tracks start from, when its pose means something.
+  std::optional<Eigen::Isometry3d> priorFramePose(const MotionPrior& prior) const;
   void accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame);
   bool wantsKeyframe(const OdometryUpdate& update) const;
   // `cloud` becomes the reference at the current pose; none when it is missing or has fewer
@@ -170,6 +205,17 @@ class KeyframeOdometry {
   CvoRegistration registration_;
   BlockPool photometric_pool_;  // num_threads threads for the photometric stage
   std::shared_ptr<const LabeledCloud> reference_;
+  // The reference is a lost frame: its pose a guess (constant velocity, a prior, or held at a
+  // restart), not a registration's.
+  bool reference_guessed_ = false;
+  // When something last moved in view: a second motion of its own among the tracks, or tracks
+  // that refused a registration.
+  std::optional<double> moving_seen_stamp_;
+  // The frame being processed, before its moving region was left out.
+  std::shared_ptr<const LabeledCloud> whole_cloud_;
+  std::optional<MotionSplit> split_;  // of the frame being processed, when it was split
+  // start <- the frame the processed frame's prior starts from (valid while it has one).
+  Eigen::Isometry3d prior_frame_pose_ = Eigen::Isometry3d::Identity();
   // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
   std::optional<std::pair<double, double>> reference_self_, source_self_;
   double reference_stamp_ = 0.0;
@@ -185,6 +231,8 @@ class KeyframeOdometry {
   Eigen::Isometry3d last_trusted_pose_ = Eigen::Isometry3d::Identity();
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;
+  // Frames since the one the feature tracks start from (the last trusted one, or a restart).
+  int frames_since_anchor_ = 0;
   bool previous_placed_by_prior_ = false;  // the last lost frame's pose came from the prior
   bool started_ = false;
   Eigen::Isometry3d base_from_camera_ = Eigen::Isometry3d::Identity();

@@ -15,6 +15,7 @@
 
 #include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/pair_kernels.hpp"
+#include "cvo_odometry/core/pixel_region.hpp"
 
 namespace cvo {
 
@@ -58,6 +59,14 @@ class LabeledCloud {
   const IntensityImage* image() const { return image_.get(); }
   void setImage(std::shared_ptr<const IntensityImage> image) { image_ = std::move(image); }
 
+  // The image region whose points were left out of this cloud (a moving object's), or null.
+  // Shared like the image; copies that keep the image keep it.
+  const PixelRegion* leftOutRegion() const { return left_out_.get(); }
+  // A copy without the points `leave_out` is true for, the image kept, and `region` as the region
+  // they were left out of.
+  LabeledCloud without(const std::function<bool(const Eigen::Vector3f&)>& leave_out,
+                       std::shared_ptr<const PixelRegion> region) const;
+
   // A copy with every position moved by `T` (features unchanged, no image: the image no longer
   // matches the positions).
   LabeledCloud transformed(const Eigen::Isometry3f& T) const;
@@ -88,6 +97,7 @@ class LabeledCloud {
   std::vector<float> colors_;
   std::vector<float> semantics_;
   std::shared_ptr<const IntensityImage> image_;
+  std::shared_ptr<const PixelRegion> left_out_;
 };
 
 }  // namespace cvo

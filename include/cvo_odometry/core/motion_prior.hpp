@@ -3,16 +3,23 @@
 // The odometry starts CVO from it and checks CVO's result against its inlier tracks.
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <Eigen/StdVector>
 
+#include "cvo_odometry/core/camera_model.hpp"
+
 namespace cvo {
 
 struct MotionPrior {
   bool solved = false;  // a motion was found (see problem otherwise)
+  // The frame the tracks start from ("previous" below): the last trusted one (FeatureTracker's
+  // anchor), by its stamp; NaN: the frame before the current one.
+  double from_stamp = std::numeric_limits<double>::quiet_NaN();
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current (camera)
   int tracks = 0;   // previous frame corners with depth tracked into the current image
   int inliers = 0;  // tracks consistent with `motion`
@@ -26,6 +33,21 @@ struct MotionPrior {
   // itself.
   std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> tracked_points;
   std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>> tracked_observations;
+  std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> tracked_pixels;
+  double inlier_px = 0.0;  // a track within this reprojection error (px) is a motion's inlier
+  // Where the current image sees the inlier tracks (pixels), and the camera that projects
+  // points there (null when its distortion model is not one CameraModel has).
+  std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> inlier_pixels;
+  std::optional<CameraModel> camera;
+  int image_width = 0, image_height = 0;
+  // A second motion among the tracks the first leaves out, when enough of them agree on one: an
+  // object moving through the view (previous <- current as if that object stood still).
+  struct SecondMotion {
+    bool solved = false;
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    int inliers = 0;
+    std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> pixels;
+  } second;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
   std::string problem;    // why no motion was solved
   double time_ms = 0.0;   // tracking and solving, on the caller's thread

@@ -25,6 +25,7 @@
 #include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
 #include "cvo_odometry/core/motion_prior.hpp"
+#include "cvo_odometry/core/pixel_region.hpp"
 
 namespace cvo {
 
@@ -59,10 +60,13 @@ struct PhotometricTracks {
 // only with photometric_translation, has no bound of its own). `tracks` count only with
 // params.photometric_tracks, and only when at least 6 are in front and the intensities fill at
 // least 24 cells; report.tracks says how many joined. The points are evaluated on `pool` (null:
-// this thread); the result is the same on any thread count.
+// this thread); the result is the same on any thread count. No sample is taken where either
+// image excludes its pixel (IntensityImage::usable) nor, in the reference image, inside
+// `reference_left_out` (a moving object's region there; may be null).
 PhotometricRotationResult refineRotationPhotometrically(
     const IntensityImage& reference, const IntensityImage& current, const LabeledCloud& cloud,
     const Eigen::Isometry3d& reference_from_current, const CvoParams& params,
-    BlockPool* pool = nullptr, const PhotometricTracks* tracks = nullptr);
+    BlockPool* pool = nullptr, const PhotometricTracks* tracks = nullptr,
+    const PixelRegion* reference_left_out = nullptr);
 
 }  // namespace cvo

@@ -33,7 +33,11 @@ struct CloudBuilderOptions {
   // (sigmas ..., 2, 1, 0 px; 0: no image attached).
   int image_levels = 2;
   int semantic_classes = 0;  // > 0: a segmentation image is expected
+  // Classes no stage uses: moving things (people, vehicles) and what has no reliable depth (sky).
   std::vector<int> ignore_classes;
+  // Their pixels grown by this much (px) before anything is left out: labels are never
+  // pixel-exact, and a corner on the outline moves with the object.
+  int ignore_border_px = 8;
 
   // Throws std::invalid_argument naming the option that makes no sense.
   void validate() const;
@@ -53,14 +57,19 @@ struct FrontendStats {
 struct FrameImages {
   cv::Mat grey;
   cv::Mat depth;
+  // CV_8UC1, non-zero where no stage may use the pixel (an ignored class, grown by
+  // ignore_border_px); empty when every pixel may be used. The one place that decides it: the
+  // cloud, the feature tracks and the photometric stage all read it.
+  cv::Mat excluded;
 };
 
 // The grey image for the photometric stage: `levels` blurs of `image` (8-bit BGR or grey), or
 // null when levels is 0 or the distortion model is not one CameraModel projects. With `buffers`,
 // the levels are written into buffers taken from it and handed back when the image is destroyed.
+// `excluded` (CV_8UC1 of the image's size, or empty): pixels the stage must not use.
 std::shared_ptr<const IntensityImage> intensityImage(
     const cv::Mat& image, const PinholeIntrinsics& intrinsics, int levels,
-    const std::shared_ptr<FloatBufferPool>& buffers = nullptr);
+    const std::shared_ptr<FloatBufferPool>& buffers = nullptr, const cv::Mat& excluded = cv::Mat());
 
 // Rays (x/z, y/z) through pixel centres (or sub-pixel positions), undistorted when the
 // intrinsics carry distortion.

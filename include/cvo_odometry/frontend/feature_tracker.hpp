@@ -8,12 +8,15 @@
 
 #include <functional>
 #include <future>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "cvo_odometry/core/motion_prior.hpp"
+#include "cvo_odometry/core/pixel_region.hpp"
 #include "cvo_odometry/frontend/min_eigen_corners.hpp"
 #include "cvo_odometry/frontend/pinhole_intrinsics.hpp"
 
@@ -27,6 +30,10 @@ struct FeatureTrackerOptions {
   int levels = 4;               // pyramid levels above the image
   double max_flow_error = 1.0;  // px, forward-backward
   double ransac_px = 1.5;       // PnP inlier threshold (px)
+  // Corners spread over square cells, this many across the image, none holding more than its
+  // share (0: the strongest anywhere): a corner-rich object moving through the view must not
+  // hold most of the tracks.
+  int grid_columns = 8;
 
   void validate() const;
 };
@@ -38,19 +45,31 @@ class FeatureTracker {
   FeatureTracker(const FeatureTracker&) = delete;
   FeatureTracker& operator=(const FeatureTracker&) = delete;
 
-  // The previous frame's corners tracked into `grey` (8-bit) and previous <- current solved from
+  // The anchor frame's corners tracked into `grey` (8-bit) and anchor <- current solved from
   // them (`solved` false with the reason when it cannot be); then this frame's own corners are
   // found, from its metric depth (CV_32FC1, NaN invalid) below `crop_top_rows`, for the next
   // frame: on a thread of their own, since only the next frame needs them (the caller's frame
   // goes on meanwhile; the next call waits for them, so the result does not depend on timing).
-  // The first frame after construction or reset() only seeds.
+  // The anchor is the previous frame, unless frameJudged() kept an older one. The first frame
+  // after construction or reset() only seeds. `excluded` (CV_8UC1 of the image's size, or
+  // empty): pixels no corner may be taken at or tracked into (FrameImages::excluded). `stamp`
+  // names the frame: the prior's from_stamp is its anchor's.
   MotionPrior track(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
-                    int crop_top_rows = 0);
-  // The last frame's depths are built differently from now on (a new stereo disparity offset):
-  // its corners move along their rays to depth new_depth(z) (waits for them); those given no
+                    int crop_top_rows = 0, const cv::Mat& excluded = cv::Mat(),
+                    double stamp = std::numeric_limits<double>::quiet_NaN());
+  // What the odometry made of the frame just tracked. Untrusted: the next frame is tracked from
+  // the anchor still (the last trusted frame), so that its prior relates it to a frame whose
+  // pose is known; a frame tracked from an untrusted one could not be judged. Trusted: its
+  // corners become the anchor, those within `moving_region` (where it saw an object moving
+  // through the view; may be null) as the object's, so that the next prior's first motion is
+  // the scene's even where the object holds most of the corners. Without a call the frame
+  // becomes the anchor, its corners all the scene's.
+  void frameJudged(bool trusted, std::shared_ptr<const PixelRegion> moving_region = nullptr);
+  // The kept frames' depths are built differently from now on (a new stereo disparity offset):
+  // their corners move along their rays to depth new_depth(z) (waits for them); those given no
   // positive finite depth are dropped.
   void remapDepths(const std::function<float(float)>& new_depth);
-  // The last frame left corners to track (waits for them).
+  // A frame left corners to track (waits for them).
   bool seeded();
   // A frame was tracked since construction or reset(): the next prior relates two frames, solved
   // or with the reason why not (no corners, a failed corner search).
@@ -58,31 +77,45 @@ class FeatureTracker {
   void reset();
 
  private:
+  // A frame's corners: what a later frame is tracked from.
+  struct Corners {
+    std::vector<cv::Point3f> points;                   // the frame's camera frame
+    std::vector<cv::Point2f> pixels;                   // where its image sees them
+    std::vector<cv::Mat> pyramid;                      // of its image
+    std::shared_ptr<const PixelRegion> moving_region;  // in its image, or null
+    double stamp = std::numeric_limits<double>::quiet_NaN();
+    bool empty() const { return points.empty() || pyramid.empty(); }
+  };
   // The KLT pyramid of `grey`, built in the buffers of `reuse` where their sizes fit.
   std::vector<cv::Mat> pyramid(const cv::Mat& grey, std::vector<cv::Mat> reuse) const;
   // Finds this frame's corners in seed_grey_ and seed_depth_ (written again only after
-  // finishSeeding()), after forgetCorners().
+  // finishSeeding()) into candidate_.
   void seed(const cv::Mat& grey, const cv::Mat& depth, const PinholeIntrinsics& intrinsics,
             int crop_top_rows, std::vector<cv::Mat> pyramid);
   // Waits for the corners being found, if any; a failure there leaves none, and says why.
   void finishSeeding();
-  // Drops the corners and the pyramid they were found in: nothing to track from.
-  void forgetCorners();
+  // The candidate becomes the anchor, or is dropped, as frameJudged() said.
+  void settleCandidate();
+  // Drops `corners`, keeping its pyramid's buffers for the next frame.
+  void recycle(Corners& corners);
   // track() after the wait: the prior, then this frame's corners started on their thread.
   MotionPrior trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
-                           const PinholeIntrinsics& intrinsics, int crop_top_rows);
+                           const PinholeIntrinsics& intrinsics, int crop_top_rows,
+                           const cv::Mat& excluded, double stamp);
   MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Size& size,
-                    const PinholeIntrinsics& intrinsics) const;
+                    const PinholeIntrinsics& intrinsics, const cv::Mat& excluded) const;
 
   FeatureTrackerOptions options_;
-  MinEigenCorners corners_;            // used by seed() only
-  std::vector<cv::Point3f> points_;    // the previous frame's camera frame
-  std::vector<cv::Point2f> pixels_;    // where the previous image sees them
-  std::vector<cv::Mat> last_pyramid_;  // of the previous image
-  // The one before, done with: the next frame's pyramid is built in its buffers (~2 MB a frame
-  // at 640x480, otherwise allocated and first touched anew).
+  MinEigenCorners corners_;         // used by seed() only
+  Corners anchor_;                  // tracked from
+  Corners candidate_;               // the last tracked frame's (found on the seeding thread)
+  bool candidate_pending_ = false;  // found, not yet settled
+  bool candidate_kept_ = true;      // frameJudged()'s word on it
+  std::shared_ptr<const PixelRegion> candidate_region_;
+  // Pyramids done with: the next frame's is built in their buffers (~2 MB a frame at 640x480,
+  // otherwise allocated and first touched anew).
   std::vector<cv::Mat> spare_pyramid_;
-  std::future<void> seeding_;       // the previous frame's corners, being found
+  std::future<void> seeding_;       // the last frame's corners, being found
   cv::Mat seed_grey_, seed_depth_;  // that frame's images, read by the search only
   double seed_ms_ = 0.0;            // how long they took
   std::string seed_problem_;        // why finding them failed

@@ -21,9 +21,13 @@ class MinEigenCorners {
   // NaN, at least `min_distance` px apart (0: any), at most `max_corners` (<= 0: no limit),
   // each above `quality` (in (0, 1]) times the strongest such pixel's response. Gradients read
   // the rows above first_row where there are any (the image's border is reflected, as OpenCV's
-  // default border). Bad arguments throw std::invalid_argument.
+  // default border). With `grid_columns` > 0 the corners are spread: the image below first_row
+  // is cut into square cells, grid_columns across, and no cell keeps more than its share of
+  // max_corners (a corner-rich patch, a textured moving object say, holds no more of the corners
+  // than of the image). Bad arguments throw std::invalid_argument.
   const std::vector<cv::Point2f>& find(const cv::Mat& grey, const cv::Mat& depth, int first_row,
-                                       int max_corners, double quality, double min_distance);
+                                       int max_corners, double quality, double min_distance,
+                                       int grid_columns = 0);
 
  private:
   void gradientProductRow(const cv::Mat& grey, int row, int slot);
@@ -38,6 +42,9 @@ class MinEigenCorners {
   std::vector<std::uint8_t> is_peak_;
   std::vector<std::pair<float, std::int64_t>> candidates_;  // response, pixel index
   std::vector<std::vector<cv::Point2f>> cells_;             // kept corners by grid cell
+  std::vector<int> bucket_counts_;                          // kept corners by spreading cell
+  std::vector<float> bucket_threshold_;                     // each spreading cell's least response
+  std::vector<float> row_threshold_;  // the least response of each pixel of a row
   std::vector<cv::Point2f> corners_;
 };
 

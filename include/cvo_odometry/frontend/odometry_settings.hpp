@@ -70,8 +70,14 @@ void visitSettings(OdometrySettings& s, V&& v) {
   v(SettingInfo{"semantic_classes", "semantics",
                 "classes of the segmentation images (0: no segmentation)", 0, 65536},
     s.cloud.semantic_classes);
-  v(SettingInfo{"ignore_classes", "semantics", "class ids whose pixels are never used", 0, 65535},
+  v(SettingInfo{"ignore_classes", "semantics",
+                "class ids no stage uses (cloud, feature tracks, photometric stage): moving "
+                "things such as people and vehicles, and sky",
+                0, 65535},
     s.cloud.ignore_classes);
+  v(SettingInfo{"ignore_border_px", "semantics",
+                "ignored classes' pixels grown by this (px): labels are never pixel-exact", 0, 200},
+    s.cloud.ignore_border_px);
   v(SettingInfo{"num_disparities", "stereo", "SGBM disparity range (a multiple of 16)", 16, 1024},
     s.stereo.num_disparities);
   v(SettingInfo{"block_size", "stereo", "SGBM block size (odd)", 1, 21}, s.stereo.block_size);
@@ -101,6 +107,12 @@ void visitSettings(OdometrySettings& s, V&& v) {
   v(SettingInfo{"feature_min_distance", "features", "least distance between corners (px)", 1.0,
                 200.0},
     s.features.min_distance);
+  v(SettingInfo{"feature_grid", "features",
+                "corners spread over square cells, this many across the image, none holding more "
+                "than its share (0: off): a corner-rich moving object holds no more of the tracks "
+                "than of the image",
+                0, 1000},
+    s.features.grid_columns);
   v(SettingInfo{"klt_window", "features", "KLT window (px)", 5, 101}, s.features.window);
   v(SettingInfo{"klt_levels", "features", "KLT pyramid levels above the image", 0, 8},
     s.features.levels);

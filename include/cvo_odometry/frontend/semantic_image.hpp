@@ -17,6 +17,8 @@ class SemanticImage {
   // Writes the probabilities of pixel (u, v) to `out` (classes floats); false if the pixel's
   // most likely class is ignored or its id is out of range.
   bool probabilities(int u, int v, float* out) const;
+  // CV_8UC1, 255 where probabilities() is false (an ignored class, or an id out of range), else 0.
+  cv::Mat excludedMask() const;
   int classes() const { return classes_; }
   cv::Size size() const { return image_.size(); }
 

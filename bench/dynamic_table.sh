@@ -1,0 +1,205 @@
+#!/usr/bin/env bash
+# shellcheck source-path=SCRIPTDIR
+# Moving objects: the bundled sequences with a textured board composited into every frame
+# (cvo_make_dynamic: sizes, textures, speeds, distances, directions, exact or imperfect labels),
+# and per case, side by side on the same frames: ours without labels, ours with the object's
+# class in ignore_classes, and the OpenCV peers (no failure flag: every pose counts as trusted).
+# Each cell: tracked/recovered/lost/restarted frames, frame-to-frame error of the trusted poses
+# (mm / deg), and the silent count (trusted frames off the ground truth's step from the trusted
+# frame before by > 1 deg, or by > half the step and > 2 cm; a pair across a restart is not
+# judged). Ours runs with lost_frame_policy publish_nothing, so that only trusted poses are in
+# its trajectory.
+# Usage: bench/dynamic_table.sh [--quick] [--check] [--no-peers] [--tum DIR] [--kitti DIR]
+#                               [--bin DIR]
+#   --quick     one TUM case (the issue's person), labelled and not; no peers (CI)
+#   --check     exit 1 when a run of ours has a silent failure, or a labelled run loses a frame
+#   --no-peers  skip the OpenCV peers (they need bench/peer_build.sh's build: PCL, contrib)
+#   --tum, --kitti  the sequences (default: the bundled excerpts; KITTI: every frame there)
+#   --bin DIR   our tools (default: build/devel/lib/cvo_odometry)
+set -euo pipefail
+# shellcheck source=../scripts/env.sh
+source "$(dirname "$0")/../scripts/env.sh"
+quick=false check=false peers_on=true
+tum=$CVO_ROOT/test/data/tum_fr1_xyz kitti=$CVO_ROOT/test/data/kitti_06_stereo
+bin=$CVO_BUILD/devel/lib/cvo_odometry
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) quick=true peers_on=false ;;
+    --check) check=true ;;
+    --no-peers) peers_on=false ;;
+    --tum) tum=$2; shift ;;
+    --kitti) kitti=$2; shift ;;
+    --bin) bin=$2; shift ;;
+    *) sed -n '3,18p' "$0" >&2; exit 2 ;;
+  esac
+  shift
+done
+for tool in cvo_make_dynamic cvo_run_sequence cvo_evaluate; do
+  [ -x "$bin/$tool" ] || { echo "dynamic_table: no $bin/$tool (build it, or --bin DIR)" >&2; exit 2; }
+done
+if $peers_on; then
+  # shellcheck source=peer_build.sh
+  source "$CVO_ROOT/bench/peer_build.sh"
+  peer_build
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# name|dataset|cvo_make_dynamic options. TUM fr1_xyz: the camera moves 0.37 m forward over the
+# 37 frames, so a board that should stay 0.5-0.7 m away walks away from it at 0.2 m/s.
+tum_cases=(
+  "person: a third, blocks, across|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5"
+)
+if ! $quick; then
+  tum_cases+=(
+    "small: a tenth, blocks|tum|--area 0.1 --depth 0.65 --velocity 0.25,0,0.2 --start 0.3,0.5"
+    "large: half, blocks|tum|--area 0.5 --depth 0.65 --velocity 0.2,0,0.2 --start 0.3,0.5"
+    "plain: a third, plain|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --texture plain"
+    "checker: a third, checkerboard|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --texture checker"
+    "scene: a third, the scene's texture|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --texture scene"
+    "stripes: a third, ellipse|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --texture stripes --shape ellipse"
+    "fast: a third, 0.6 m/s across|tum|--area 0.33 --depth 0.65 --velocity 0.6,0,0.2 --start 0.15,0.5"
+    "towards: approaching from 1.2 m|tum|--area 0.12 --depth 1.2 --velocity 0,0,-0.4 --start 0.5,0.45"
+    "far: a fifth at 0.9 m|tum|--area 0.2 --depth 0.9 --velocity 0.3,0,0.25 --start 0.25,0.5"
+    "along: a quarter moving with the camera|tum|--area 0.25 --depth 0.6 --with-camera --velocity 0.1,0,0 --start 0.3,0.55"
+    "labels 4 px short: person|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --label-error 4"
+  )
+fi
+kitti_cases=()
+if ! $quick; then
+  kitti_cases=(
+    "van along: a sixth, 9 m, drifting|kitti|--area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6"
+    "van crossing: 30 m ahead, 8 m/s|kitti|--area 0.05 --depth 30 --velocity 8,0,0 --start 0.2,0.6"
+    "truck along: a third, 8 m|kitti|--area 0.3 --depth 8 --with-camera --velocity 1,0,0 --start 0.45,0.6"
+    "overtaking: a car pulling away|kitti|--area 0.15 --depth 7 --with-camera --velocity 0,0,3 --start 0.6,0.62"
+  )
+fi
+
+# "trusted/recovered/lost|mm|deg|silent" of a runner log.
+ours_cell() {
+  awk '/^tracking:/ { t = $2; r = $4; l = $6; x = $8 }
+       /^RPE frame-to-frame/ && !done { mm = $5 * 1000; deg = $7; done = 1 }
+       /^silent failures:/ { s = $3 }
+       END { if (done) printf "%d/%d/%d/%d|%.2f|%.3f|%s\n", t, r, l, x, mm, deg, s
+             else printf "%d/%d/%d/%d|-|-|0\n", t, r, l, x }' "$1"
+}
+# "mm|deg|silent" of a cvo_evaluate --all-trusted log.
+peer_cell() {
+  awk '/^RPE frame-to-frame/ { mm = $5 * 1000; deg = $7 }
+       /^silent failures:/ { s = $3 }
+       END { printf "%.2f|%.3f|%s\n", mm, deg, s }' "$1"
+}
+
+failed=0
+rows=()
+run_case() {
+  local name=$1 kind=$2 options=$3 dir=$work/case
+  rm -rf "$dir"
+  local source=$tum gt
+  [ "$kind" = kitti ] && source=$kitti
+  # shellcheck disable=SC2086  # the options are words
+  "$bin/cvo_make_dynamic" "--$kind" "$source" --out "$dir" $options >"$work/make.log" 2>&1 ||
+    { cat "$work/make.log" >&2; exit 1; }
+  local covers
+  covers=$(sed -n 's/.*covers \([0-9.]*\) % of the first image (median \([0-9.]*\) %), moves \([0-9.]*\) px.*/\1-\2 %, \3 px\/frame/p' "$work/make.log")
+  gt=$dir/groundtruth.txt
+  [ "$kind" = kitti ] && gt=$dir/poses.txt
+  local ours=() variant
+  for variant in unlabelled labelled; do
+    local extra=()
+    [ "$variant" = labelled ] &&
+      extra=(--segmentation "$dir/labels" --semantic-classes 2 --ignore-classes 1)
+    # A run that trusts fewer than two frames has no error to evaluate: its cell says so.
+    "$bin/cvo_run_sequence" "--$kind" "$dir" --gt "$gt" --quiet --set backend=cpu \
+      --lost-frame-policy publish_nothing "${extra[@]}" >"$work/$variant.log" 2>&1 ||
+      grep -q "^tracking:" "$work/$variant.log" || { tail -5 "$work/$variant.log" >&2; exit 1; }
+    ours+=("$(ours_cell "$work/$variant.log")")
+  done
+  local peer_cells=()
+  if $peers_on; then
+    local method
+    for method in opencv_rgbd opencv_icp; do
+      "$peers" "--$kind" "$dir" --method "$method" --out "$work/$method.txt" \
+        >"$work/$method.out" 2>"$work/$method.log" || { cat "$work/$method.log" >&2; exit 1; }
+      local times=()
+      [ "$kind" = kitti ] && times=(--gt-times "$dir/times.txt" --est-times "$dir/times.txt")
+      "$evaluate" --gt "$gt" --est "$work/$method.txt" --all-trusted "${times[@]}" \
+        >"$work/$method.eval" 2>&1 || { cat "$work/$method.eval" >&2; exit 1; }
+      peer_cells+=("$(peer_cell "$work/$method.eval")")
+    done
+  fi
+  rows+=("$name|$covers|${ours[0]}|${ours[1]}|$(IFS='|'; echo "${peer_cells[*]:-}")")
+  if $check; then
+    local silent_u silent_l lost_l
+    silent_u=$(echo "${ours[0]}" | cut -d'|' -f4)
+    silent_l=$(echo "${ours[1]}" | cut -d'|' -f4)
+    lost_l=$(echo "${ours[1]}" | cut -d'|' -f1 | cut -d/ -f3)
+    if [ "$silent_u" != 0 ] || [ "$silent_l" != 0 ] || [ "$lost_l" != 0 ]; then
+      echo "dynamic_table: $name: silent failures $silent_u (no labels) / $silent_l (labels)," \
+        "labelled frames lost $lost_l" >&2
+      failed=1
+    fi
+  fi
+}
+
+# The static sequences first: the figures each case is compared with.
+static_row() {
+  local kind=$1 source=$2 gt=$3
+  "$bin/cvo_run_sequence" "--$kind" "$source" --gt "$gt" --quiet --set backend=cpu \
+    --lost-frame-policy publish_nothing >"$work/static.log" 2>&1 ||
+    { tail -5 "$work/static.log" >&2; exit 1; }
+  local cell
+  cell=$(ours_cell "$work/static.log")
+  local peer_cells=()
+  if $peers_on; then
+    local method
+    for method in opencv_rgbd opencv_icp; do
+      "$peers" "--$kind" "$source" --method "$method" --out "$work/$method.txt" \
+        >"$work/$method.out" 2>"$work/$method.log" || { cat "$work/$method.log" >&2; exit 1; }
+      local times=()
+      [ "$kind" = kitti ] && times=(--gt-times "$source/times.txt" --est-times "$source/times.txt")
+      "$evaluate" --gt "$gt" --est "$work/$method.txt" --all-trusted "${times[@]}" \
+        >"$work/$method.eval" 2>&1 || { cat "$work/$method.eval" >&2; exit 1; }
+      peer_cells+=("$(peer_cell "$work/$method.eval")")
+    done
+  fi
+  rows+=("$kind without an object|-|$cell|-|-|-|-|$(IFS='|'; echo "${peer_cells[*]:-}")")
+}
+
+static_row tum "$tum" "$tum/groundtruth.txt"
+for entry in "${tum_cases[@]}"; do
+  IFS='|' read -r name kind options <<<"$entry"
+  run_case "$name" "$kind" "$options"
+done
+if [ ${#kitti_cases[@]} -gt 0 ]; then
+  static_row kitti "$kitti" "$kitti/poses.txt"
+  for entry in "${kitti_cases[@]}"; do
+    IFS='|' read -r name kind options <<<"$entry"
+    run_case "$name" "$kind" "$options"
+  done
+fi
+
+echo "Moving objects ($(basename "$tum"), $(basename "$kitti")): per run tracked/recovered/lost/" \
+  "restarted frames, frame-to-frame error of trusted poses (mm / deg), silent failures"
+header="| case | object: share of image, motion | ours, no labels | ours, labelled |"
+rule="|---|---|---|---|"
+if $peers_on; then
+  header="$header OpenCV RgbdOdometry | OpenCV ICPOdometry |"
+  rule="$rule---|---|"
+fi
+echo "$header"
+echo "$rule"
+for row in "${rows[@]}"; do
+  IFS='|' read -r -a f <<<"$row"
+  line="| ${f[0]} | ${f[1]} | ${f[2]}: ${f[3]} mm / ${f[4]} deg, ${f[5]} silent |"
+  if [ "${f[6]}" = "-" ]; then
+    line="$line - |"
+  else
+    line="$line ${f[6]}: ${f[7]} mm / ${f[8]} deg, ${f[9]} silent |"
+  fi
+  if $peers_on; then
+    line="$line ${f[10]:-?} mm / ${f[11]:-?} deg, ${f[12]:-?} silent | ${f[13]:-?} mm / ${f[14]:-?} deg, ${f[15]:-?} silent |"
+  fi
+  echo "$line"
+done
+exit "$failed"

@@ -1,0 +1,51 @@
+// Two motions among a frame's feature tracks (MotionPrior::second: an object moving through the
+// view), and which of them the scene, the static world, follows. The tracks alone cannot say:
+// a textured object can hold more of them than the background. What can: an object moving
+// through the view is in front of what it hides, so the scene is the motion of the farther
+// tracks; and the camera keeps its velocity, so the scene's motion is the one nearer the
+// constant-velocity prediction. When that evidence is missing or contradicts itself the split is
+// undecided, and the frame must not be trusted.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "cvo_odometry/core/motion_prior.hpp"
+
+namespace cvo {
+
+enum class SceneMotion { kFirst, kSecond, kUndecided };
+
+struct MotionSplit {
+  // Per tracked point (MotionPrior::tracked_points): 0 the first motion explains it better, 1
+  // the second, -1 neither within the prior's inlier_px.
+  std::vector<int> owner;
+  int first_tracks = 0, second_tracks = 0;
+  double first_depth = 0.0, second_depth = 0.0;  // median depth of each one's tracks (m)
+  SceneMotion scene = SceneMotion::kUndecided;
+  std::string why;  // how it was decided, or why it could not be
+};
+
+// Mean image distance (px) between where motions a and b (previous <- current) put the prior's
+// tracked points: how far apart two motions are where it matters, on any scale.
+double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
+                      const Eigen::Isometry3d& b);
+
+// Splits the prior's tracks between its two motions and decides which the scene follows: the
+// motion of the tracks behind, where the two motions' tracks are image neighbours and one's
+// are in front in most pairs (occlusion); else the farther tracks' when their median depth is
+// at least `depth_ratio` times the other's and the constant-velocity prediction `predicted`
+// (previous <- current) is not clearly nearer the other; else the motion with more tracks when
+// the other has fewer than `lopsided_ratio` times as many, or when it is also the one nearer
+// the prediction; else undecided. Requires prior.second.solved.
+MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
+                         const std::optional<Eigen::Isometry3d>& predicted);
+
+// The prior as the scene sees it: the scene's motion first, its own tracks alone as the inliers
+// (those the other motion explains better left out), the other motion second with its own.
+MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split);
+
+}  // namespace cvo

@@ -1,0 +1,185 @@
+#include "cvo_odometry/core/motion_split.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "cvo_odometry/core/robust_scale.hpp"
+
+namespace cvo {
+
+namespace {
+
+// A motion is clearly the nearer to a prediction when at most this fraction as far from it as
+// the other.
+constexpr double kClearlyNearer = 0.5;
+// Tracks of the two motions within this share of the image's width are neighbours; one is in
+// front of the other when at least kFrontMargin nearer; the motion whose tracks are in front in
+// kFrontShare of at least kMinNeighbourPairs such pairs hides the other.
+constexpr double kNeighbourShare = 0.075;
+constexpr double kFrontMargin = 0.05;
+constexpr double kFrontShare = 0.75;
+constexpr int kMinNeighbourPairs = 10;
+
+// Reprojection error (px) of the prior's tracked point k under motion (previous <- current)
+// given as current <- previous.
+double errorPx(const MotionPrior& prior, std::size_t k,
+               const Eigen::Isometry3d& current_from_previous) {
+  const Eigen::Vector3d p = current_from_previous * prior.tracked_points[k];
+  if (!(p.z() > 1e-6)) return INFINITY;
+  return prior.focal_px * (p.head<2>() / p.z() - prior.tracked_observations[k]).norm();
+}
+
+}  // namespace
+
+double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
+                      const Eigen::Isometry3d& b) {
+  const Eigen::Isometry3d a_inv = a.inverse(), b_inv = b.inverse();
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const Eigen::Vector3d& X : prior.tracked_points) {
+    const Eigen::Vector3d pa = a_inv * X, pb = b_inv * X;
+    if (!(pa.z() > 1e-6) || !(pb.z() > 1e-6)) continue;
+    sum += prior.focal_px * (pa.head<2>() / pa.z() - pb.head<2>() / pb.z()).norm();
+    ++n;
+  }
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
+MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
+                         const std::optional<Eigen::Isometry3d>& predicted) {
+  MotionSplit split;
+  const Eigen::Isometry3d first = prior.motion.inverse(), second = prior.second.motion.inverse();
+  std::vector<double> first_depths, second_depths;
+  split.owner.assign(prior.tracked_points.size(), -1);
+  for (std::size_t k = 0; k < prior.tracked_points.size(); ++k) {
+    const double e1 = errorPx(prior, k, first), e2 = errorPx(prior, k, second);
+    if (std::min(e1, e2) > prior.inlier_px) continue;
+    split.owner[k] = e1 <= e2 ? 0 : 1;
+    (e1 <= e2 ? first_depths : second_depths).push_back(prior.tracked_points[k].z());
+  }
+  split.first_tracks = static_cast<int>(first_depths.size());
+  split.second_tracks = static_cast<int>(second_depths.size());
+  std::ostringstream why;
+  why.precision(3);
+  why << "tracks split between two motions (" << split.first_tracks << " and "
+      << split.second_tracks << " tracks";
+  if (first_depths.empty() || second_depths.empty()) {
+    // One explains every track the other does: no split after all.
+    split.scene = first_depths.empty() ? SceneMotion::kSecond : SceneMotion::kFirst;
+    split.why = "one motion explains every track";
+    return split;
+  }
+  split.first_depth = medianInPlace(first_depths);
+  split.second_depth = medianInPlace(second_depths);
+  why << ", median depths " << split.first_depth << " and " << split.second_depth << " m)";
+  // Where the two motions' tracks are neighbours in the image, the object's are in front.
+  const double reach = kNeighbourShare * prior.image_width;
+  int first_in_front = 0, second_in_front = 0;
+  for (std::size_t i = 0; i < split.owner.size(); ++i) {
+    if (split.owner[i] != 0) continue;
+    for (std::size_t j = 0; j < split.owner.size(); ++j) {
+      if (split.owner[j] != 1) continue;
+      if ((prior.tracked_pixels[i] - prior.tracked_pixels[j]).norm() > reach) continue;
+      const double zi = prior.tracked_points[i].z(), zj = prior.tracked_points[j].z();
+      if (zi < (1.0 - kFrontMargin) * zj) ++first_in_front;
+      if (zj < (1.0 - kFrontMargin) * zi) ++second_in_front;
+    }
+  }
+  const int pairs = first_in_front + second_in_front;
+  std::optional<SceneMotion> behind;  // the motion of what the other hides
+  if (pairs >= kMinNeighbourPairs) {
+    if (first_in_front >= kFrontShare * pairs) behind = SceneMotion::kSecond;
+    if (second_in_front >= kFrontShare * pairs) behind = SceneMotion::kFirst;
+    if (behind) {
+      why << "; " << std::max(first_in_front, second_in_front) << " of " << pairs
+          << " neighbouring pairs have the " << (behind == SceneMotion::kFirst ? "second" : "first")
+          << " motion's track in front";
+    }
+  }
+  const SceneMotion farther = behind                                    ? *behind
+                              : split.first_depth >= split.second_depth ? SceneMotion::kFirst
+                                                                        : SceneMotion::kSecond;
+  const double ratio = behind ? INFINITY
+                              : std::max(split.first_depth, split.second_depth) /
+                                    std::max(std::min(split.first_depth, split.second_depth), 1e-9);
+  // The prediction speaks only when it is clearly nearer one motion: the camera's velocity from
+  // one step is a few pixels off, and two slow motions can be as near each other.
+  std::optional<SceneMotion> nearer_prediction;
+  if (predicted) {
+    const double to_first = motionsApartPx(prior, *predicted, prior.motion);
+    const double to_second = motionsApartPx(prior, *predicted, prior.second.motion);
+    if (to_first <= kClearlyNearer * to_second) nearer_prediction = SceneMotion::kFirst;
+    if (to_second <= kClearlyNearer * to_first) nearer_prediction = SceneMotion::kSecond;
+  }
+  const auto name = [](SceneMotion m) { return m == SceneMotion::kFirst ? "first" : "second"; };
+  if (ratio >= depth_ratio) {
+    // Occlusion between neighbours is the stronger evidence: a one-step velocity is a few pixels
+    // off, as far as two slow motions are apart. Only the global depth ratio gives way to it.
+    if (!behind && nearer_prediction && *nearer_prediction != farther) {
+      why << ": the " << (behind ? "tracks behind" : "farther tracks") << " follow the "
+          << name(farther) << " motion, the constant-velocity prediction the "
+          << name(*nearer_prediction);
+      split.why = why.str();
+      return split;
+    }
+    split.scene = farther;
+    why << ": the scene follows the " << (behind ? "tracks behind" : "farther tracks") << ", the "
+        << name(farther) << " motion";
+    split.why = why.str();
+    return split;
+  }
+  const SceneMotion more =
+      split.first_tracks >= split.second_tracks ? SceneMotion::kFirst : SceneMotion::kSecond;
+  const double share = static_cast<double>(std::min(split.first_tracks, split.second_tracks)) /
+                       std::max(split.first_tracks, split.second_tracks);
+  if (share < lopsided_ratio && (!nearer_prediction || *nearer_prediction == more)) {
+    split.scene = more;
+    why << ": at similar depths, the scene follows the motion with far more tracks, the "
+        << name(more);
+    split.why = why.str();
+    return split;
+  }
+  if (nearer_prediction && *nearer_prediction == more) {
+    split.scene = more;
+    why << ": at similar depths, the scene follows the motion with more tracks and nearer the "
+           "constant-velocity prediction, the "
+        << name(more);
+    split.why = why.str();
+    return split;
+  }
+  why << ": at similar depths (ratio " << ratio << " < " << depth_ratio << ")"
+      << (nearer_prediction ? ", and the motion with more tracks is not the one nearer the "
+                              "constant-velocity prediction"
+                            : ", and the constant-velocity prediction does not tell them apart");
+  split.why = why.str();
+  return split;
+}
+
+MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split) {
+  MotionPrior out = prior;
+  const bool swap = split.scene == SceneMotion::kSecond;
+  const int mine = swap ? 1 : 0;
+  out.points.clear();
+  out.observations.clear();
+  out.inlier_pixels.clear();
+  out.second.pixels.clear();
+  for (std::size_t k = 0; k < split.owner.size(); ++k) {
+    if (split.owner[k] == mine) {
+      out.points.push_back(prior.tracked_points[k]);
+      out.observations.push_back(prior.tracked_observations[k]);
+      out.inlier_pixels.push_back(prior.tracked_pixels[k]);
+    } else if (split.owner[k] >= 0) {
+      out.second.pixels.push_back(prior.tracked_pixels[k]);
+    }
+  }
+  out.inliers = static_cast<int>(out.points.size());
+  out.inlier_ratio = prior.tracked_points.empty()
+                         ? 0.0
+                         : static_cast<double>(out.inliers) / prior.tracked_points.size();
+  out.second.inliers = static_cast<int>(out.second.pixels.size());
+  if (swap) std::swap(out.motion, out.second.motion);
+  return out;
+}
+
+}  // namespace cvo
