@@ -26,6 +26,22 @@ std::string stampText(double stamp) {
   return out.str();
 }
 
+// The prior without the tracks the current image sees inside `region`.
+MotionPrior withoutTracksIn(const MotionPrior& prior, const PixelRegion& region) {
+  MotionPrior out = prior;
+  out.tracked_points.clear();
+  out.tracked_observations.clear();
+  out.tracked_pixels.clear();
+  for (std::size_t k = 0; k < prior.tracked_points.size(); ++k) {
+    const Eigen::Vector2f& pixel = prior.tracked_pixels[k];
+    if (region.contains(pixel.x(), pixel.y())) continue;
+    out.tracked_points.push_back(prior.tracked_points[k]);
+    out.tracked_observations.push_back(prior.tracked_observations[k]);
+    out.tracked_pixels.push_back(pixel);
+  }
+  return out;
+}
+
 }  // namespace
 
 OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFactory factory)
@@ -219,8 +235,17 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   if (stereo) {
     result.disparity_offset = offset_calibration_->offset();
     const auto calibration_start = std::chrono::steady_clock::now();
-    if (offset_calibration_->update(*stereo, images.depth, result.prior,
-                                    result.update.trusted() && !result.update.firstFrame())) {
+    // Its depths pair with the previous frame's: only tracks from that frame, and none on an
+    // object the odometry found moving (its tracks follow the object, not the rig's scale).
+    const bool from_previous = result.prior && (std::isnan(result.prior->from_stamp) ||
+                                                (last && result.prior->from_stamp == *last));
+    std::optional<MotionPrior> scene_tracks = result.prior;
+    if (scene_tracks && result.update.moving_region) {
+      scene_tracks = withoutTracksIn(*scene_tracks, *result.update.moving_region);
+    }
+    if (offset_calibration_->update(
+            *stereo, images.depth, scene_tracks,
+            result.update.trusted() && !result.update.firstFrame() && from_previous)) {
       moveKeptDepths(result.disparity_offset, offset_calibration_->offset(),
                      offset_calibration_->focalBaseline());
     }

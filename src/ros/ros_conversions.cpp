@@ -1,6 +1,7 @@
 #include "cvo_odometry/ros/ros_conversions.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -296,6 +297,11 @@ cvo_odometry::CvoIndicator indicatorMsg(const PipelineResult& result, const ros:
   }
   indicator.track_agreement = update.track_agreement;
   indicator.track_error_px = update.track_error_px;
+  indicator.track_rotation_gap_deg = update.track_rotation_gap_deg;
+  indicator.second_motion_tracks =
+      static_cast<std::uint32_t>(std::max(update.second_motion_tracks, 0));
+  indicator.motion_split = update.motion_split;
+  indicator.left_out_share = update.left_out_share;
   indicator.new_keyframe = update.new_keyframe;
   indicator.reference_stamp = update.stamp - update.dt;
   indicator.indicator = update.report.indicator_after;
