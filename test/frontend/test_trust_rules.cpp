@@ -1,0 +1,139 @@
+// What the odometry refuses to trust, on real TUM frames with real feature tracks whose motion is
+// then bent: a pose turned away from the tracks, and a registration nobody can judge to a
+// frame placed by a guess.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "cvo_odometry/core/keyframe_odometry.hpp"
+#include "cvo_odometry/core/lie_group.hpp"
+#include "cvo_odometry/frontend/feature_tracker.hpp"
+#include "cvo_odometry/frontend/odometry_settings.hpp"
+#include "cvo_odometry/frontend/rgbd_cloud_builder.hpp"
+#include "cvo_odometry/frontend/tum_sequence.hpp"
+
+namespace {
+
+const std::string kData = CVO_TEST_DATA_DIR;
+const std::string kConfig = std::string(CVO_SOURCE_DIR) + "/config/";
+constexpr double kFrame = 1.0 / 30.0;
+
+struct Frame {
+  std::shared_ptr<const cvo::LabeledCloud> cloud;
+  cvo::FrameImages images;
+};
+
+class TumTracked {
+ public:
+  TumTracked() : sequence_(kData + "/tum_fr1_xyz") {
+    settings_ = cvo::loadOdometrySettings(kConfig + "tum_rgbd.yaml");
+    settings_.depth_scale = 5000.0;
+    settings_.cvo.backend = cvo::BackendChoice::kCpu;
+    builder_ = std::make_unique<cvo::RgbdCloudBuilder>(settings_.rgbdOptions());
+  }
+  Frame frame(std::size_t k) {
+    cvo::RgbdFrame f;
+    sequence_.load(k, &f.image, &f.depth);
+    f.intrinsics = cvo::tumIntrinsics("fr1");
+    Frame out;
+    out.cloud = std::make_shared<const cvo::LabeledCloud>(builder_->build(f, nullptr, &out.images));
+    return out;
+  }
+  // Previous <- current from the corners of frame `from` tracked into frame `to`.
+  cvo::MotionPrior prior(std::size_t from, std::size_t to) {
+    cvo::FeatureTracker tracker(settings_.features);
+    const Frame a = frame(from), b = frame(to);
+    const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+    tracker.track(a.images.grey, a.images.depth, K);
+    return tracker.track(b.images.grey, b.images.depth, K);
+  }
+  const cvo::CvoParams& params() const { return settings_.cvo; }
+
+ private:
+  cvo::TumSequence sequence_;
+  cvo::OdometrySettings settings_;
+  std::unique_ptr<cvo::RgbdCloudBuilder> builder_;
+};
+
+// The prior's motion turned by `degrees` about the camera's y axis, its tracks seen where that
+// motion puts them: tracks as consistent as real ones, of a motion off the truth.
+cvo::MotionPrior turned(cvo::MotionPrior prior, double degrees) {
+  Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
+  turn.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+  prior.motion = prior.motion * turn;
+  const Eigen::Isometry3d current_from_previous = prior.motion.inverse();
+  for (std::size_t k = 0; k < prior.points.size(); ++k) {
+    const Eigen::Vector3d p = current_from_previous * prior.points[k];
+    prior.observations[k] = p.head<2>() / p.z();
+  }
+  for (std::size_t k = 0; k < prior.tracked_points.size(); ++k) {
+    const Eigen::Vector3d p = current_from_previous * prior.tracked_points[k];
+    prior.tracked_observations[k] = p.head<2>() / p.z();
+  }
+  prior.second = {};
+  return prior;
+}
+
+cvo::OdometryFrame odometryFrame(double stamp, const Frame& frame,
+                                 std::optional<cvo::MotionPrior> prior) {
+  cvo::OdometryFrame f;
+  f.stamp = stamp;
+  f.cloud = frame.cloud;
+  f.prior = std::move(prior);
+  return f;
+}
+
+// Tracks of a motion turned 0.8 deg from the truth: within track_agreement_px (10 px) of the
+// registered pose nearly everywhere, yet turned past max_track_rotation_gap (0.5 deg): refused.
+TEST(TrustRules, APoseTurnedFromTheTracksIsNotTrusted) {
+  TumTracked tum;
+  const cvo::MotionPrior real = tum.prior(0, 1);
+  ASSERT_TRUE(real.solved) << real.problem;
+  cvo::KeyframeOdometry honest(tum.params()), bent(tum.params());
+  for (auto* odometry : {&honest, &bent})
+    odometry->process(odometryFrame(0.0, tum.frame(0), {}));
+  const cvo::OdometryUpdate right = honest.process(odometryFrame(kFrame, tum.frame(1), real));
+  EXPECT_TRUE(right.trusted()) << right.problem;
+  EXPECT_LT(right.track_rotation_gap_deg, 0.3);
+  const cvo::OdometryUpdate off =
+      bent.process(odometryFrame(kFrame, tum.frame(1), turned(real, 0.8)));
+  EXPECT_FALSE(off.trusted());
+  EXPECT_NE(off.problem.find("turns"), std::string::npos) << off.problem;
+}
+
+// A frame lost for another reason (here a speed limit it breaks) is placed by its confident
+// tracks and becomes the reference; the next frame, with no tracks to judge its registration to
+// it, is not trusted there (its pose would be the guess's times a right motion) but registered
+// to the last trusted frame instead.
+TEST(TrustRules, NoTracksNoTrustAfterAFramePlacedByAGuess) {
+  TumTracked tum;
+  const cvo::MotionPrior real = tum.prior(0, 1);
+  ASSERT_TRUE(real.solved) << real.problem;
+  cvo::KeyframeOdometry odometry(tum.params());
+  odometry.process(odometryFrame(0.0, tum.frame(0), {}));
+  cvo::CvoParams slow = tum.params();
+  slow.max_linear_speed = 0.01;  // m/s: the camera moves 0.3 m/s here
+  odometry.setParams(slow);
+  const cvo::OdometryUpdate lost = odometry.process(odometryFrame(kFrame, tum.frame(1), real));
+  ASSERT_EQ(lost.state, cvo::TrackingState::kLost) << lost.problem;
+  ASSERT_TRUE(lost.new_keyframe) << "placed by the prior, it is the next frame's reference";
+  odometry.setParams(tum.params());
+  const cvo::OdometryUpdate next = odometry.process(odometryFrame(2 * kFrame, tum.frame(2), {}));
+  EXPECT_NE(next.problem.find("placed by a guess"), std::string::npos) << next.problem;
+  EXPECT_EQ(next.state, cvo::TrackingState::kRecovered) << next.problem;
+  EXPECT_EQ(next.dt, 2 * kFrame) << "registered to frame 0, the last trusted one";
+  // With tracks from the last trusted frame the same registration is judged, and trusted.
+  cvo::KeyframeOdometry judged(tum.params());
+  judged.process(odometryFrame(0.0, tum.frame(0), {}));
+  judged.setParams(slow);
+  judged.process(odometryFrame(kFrame, tum.frame(1), real));
+  judged.setParams(tum.params());
+  cvo::MotionPrior from_start = tum.prior(0, 2);
+  from_start.from_stamp = 0.0;
+  const cvo::OdometryUpdate checked =
+      judged.process(odometryFrame(2 * kFrame, tum.frame(2), from_start));
+  EXPECT_TRUE(checked.trusted()) << checked.problem;
+}
+
+}  // namespace
