@@ -36,13 +36,22 @@ mkdir -p "$out"
 "$bin/cvo_make_bag" --tum "$data" --out "$out/tum_fr1_xyz.bag" || fail "cvo_make_bag failed"
 frames=$(cvo_bag_frames "$out/tum_fr1_xyz.bag") || fail "cannot read $out/tum_fr1_xyz.bag"
 rm -f "$out/trajectory.txt"
+launch_rc=0
 cvo_roslaunch_logged "$out/roslaunch.log" cvo_odometry play_bag.launch bag:="$out/tum_fr1_xyz.bag" \
-  backend:="$backend" rate:=0.2 pace:=true rviz:="$rviz" trajectory_file:="$out/trajectory.txt" || true
+  backend:="$backend" rate:=0.2 pace:=true rviz:="$rviz" trajectory_file:="$out/trajectory.txt" ||
+  launch_rc=$?
 poses=0
 [ ! -f "$out/trajectory.txt" ] || poses=$(cvo_pose_count "$out/trajectory.txt")
 if [ "$poses" -ne "$frames" ]; then
   why=$(cvo_first_error "$out/roslaunch.log")
-  fail "$poses of $frames poses in $out/trajectory.txt${why:+; first error: $why} (log: $out/roslaunch.log)"
+  hung=""
+  if [ "$launch_rc" -eq 124 ]; then
+    player=$(tail -qn1 "$ROS_HOME"/log/latest/player-*-stdout.log 2>/dev/null | tr -d '\r' || true)
+    hung="; the replay hung, stopped after ${CVO_ROSLAUNCH_LIMIT:-900} s (the bag player's last"
+    hung+=" line: '${player:-none}')"
+  fi
+  fail "$poses of $frames poses in $out/trajectory.txt$hung${why:+; first error: $why}" \
+    "(log: $out/roslaunch.log)"
 fi
 echo "trajectory: $out/trajectory.txt ($poses of $frames poses; log: $out/roslaunch.log)"
 "$bin/cvo_evaluate" --gt "$data/groundtruth.txt" --est "$out/trajectory.txt" ||

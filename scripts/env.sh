@@ -78,11 +78,13 @@ cvo_first_error() {
     sed 's/\x1b\[[0-9;]*m//g' | cut -c1-300
 }
 
-# roslaunch ARGS... with its output in LOG, stopped (as Ctrl-C would) when a node logs FATAL: a
-# nodelet that gives up (e.g. --backend cuda without a GPU) stays idle, and a paced bag player
-# would wait for it forever. Returns roslaunch's status.
+# roslaunch ARGS... with its output in LOG, stopped (as Ctrl-C would) when a node logs FATAL (a
+# nodelet that gives up, e.g. --backend cuda without a GPU, stays idle and a paced bag player
+# would wait for it for ever), or when it has not ended after CVO_ROSLAUNCH_LIMIT seconds (900: a
+# bound a slow or loaded machine does not reach; only a hang does, e.g. a player waiting for a
+# subscriber that never comes). Returns roslaunch's status, 124 after the limit.
 cvo_roslaunch_logged() {
-  local log=$1 launch rc=0
+  local log=$1 launch rc=0 start=$SECONDS limit=${CVO_ROSLAUNCH_LIMIT:-900}
   shift
   : >"$log"  # emptied here, before the loop reads it (not by the background job's redirection)
   roslaunch "$@" >>"$log" 2>&1 &
@@ -91,6 +93,12 @@ cvo_roslaunch_logged() {
     if grep -q '\[FATAL\]' "$log"; then
       kill -INT "$launch" 2>/dev/null || true
       break
+    fi
+    if [ $((SECONDS - start)) -ge "$limit" ]; then
+      echo "cvo_roslaunch_logged: not ended after $limit s: stopped (a hang)" >>"$log"
+      kill -INT "$launch" 2>/dev/null || true
+      wait "$launch" || true
+      return 124
     fi
     sleep 1
   done
