@@ -95,6 +95,8 @@ void CvoParams::validate() const {
           "min_track_agreement must be in [0, 1]");
   require(moving_region_px >= 0.0 && moving_region_px <= 1000.0,
           "moving_region_px must be in [0, 1000]");
+  require(moving_track_agreement >= 0.0 && moving_track_agreement <= 1.0,
+          "moving_track_agreement must be in [0, 1]");
   require(max_track_rotation_gap > 0.0 && max_track_rotation_gap <= 180.0,
           "max_track_rotation_gap must be in (0, 180]");
   require(motion_split_ratio >= 0.0 && motion_split_ratio <= 1.0,

@@ -374,8 +374,13 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     // against theirs.
     a.track_rotation_gap_deg =
         angleDeg(frame.prior->motion.inverse() * prior_from_reference * a.result.transform);
-    if (a.agreement >= p.min_track_agreement &&
-        a.track_rotation_gap_deg > p.max_track_rotation_gap) {
+    // Beside something moving the dense stages may be pulled a little off the tracks, too
+    // little for the pixel bound yet enough for a wrong pose: more of the tracks must agree.
+    const bool moving_lately =
+        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    const double needed = moving_lately ? std::max(p.min_track_agreement, p.moving_track_agreement)
+                                        : p.min_track_agreement;
+    if (a.agreement >= needed && a.track_rotation_gap_deg > p.max_track_rotation_gap) {
       // Within the pixels the tracks allow, yet turned away from them: something in view pulled
       // the dense stages (a moving object without tracks of its own).
       std::ostringstream why;
@@ -386,13 +391,14 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       a.good = false;
       a.problems = why.str();
       moving_seen_stamp_ = frame.stamp;
-    } else if (a.agreement < p.min_track_agreement) {
+    } else if (a.agreement < needed) {
       std::ostringstream why;
       why.precision(3);
       why << "feature tracks disagree: " << 100.0 * a.agreement << " % of "
           << frame.prior->points.size() << " inlier tracks within " << p.track_agreement_px
           << " px (median error " << a.track_error_px << " px; they moved " << a.track_flow_px
-          << " px) < min_track_agreement " << p.min_track_agreement;
+          << " px) < " << (moving_lately ? "moving_track_agreement " : "min_track_agreement ")
+          << needed;
       a.good = false;
       a.problems = why.str();
       moving_seen_stamp_ = frame.stamp;

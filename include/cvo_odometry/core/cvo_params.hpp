@@ -156,6 +156,9 @@ struct CvoParams {
   // any depth (static fixtures: at most 0.22 deg apart), and a pose turned further was pulled by
   // something the tracks do not follow.
   double max_track_rotation_gap = 0.5;
+  // ... and while something moved in view lately (a second motion of its own, or registrations
+  // the tracks refused, within 2 s), at least this fraction of them must agree.
+  double moving_track_agreement = 0.9;
   // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.
   double tracked_cosine_ratio = 0.25;
   // An object moving through the view shows as a second motion among the tracks (MotionPrior::

@@ -183,6 +183,11 @@ void visitSettings(CvoParams& p, V&& v) {
                 "their motion over the step",
                 0.001, 180.0},
     p.max_track_rotation_gap);
+  v(SettingInfo{"moving_track_agreement", "moving",
+                "while something moved in view lately, this fraction of the tracks must agree "
+                "with a registration (at least min_track_agreement)",
+                0.0, 1.0},
+    p.moving_track_agreement);
   v(SettingInfo{"tracked_cosine_ratio", "tracking",
                 "a registration the tracks judge needs a cosine of only this fraction of "
                 "min_cosine",
