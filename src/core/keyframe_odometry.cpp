@@ -104,7 +104,6 @@ void KeyframeOdometry::remapDepths(const std::function<float(float)>& new_depth)
   if (last_good_ && last_good_->cloud) {
     last_good_->cloud = last_good_->cloud == before ? reference_ : remapped(last_good_->cloud);
   }
-  if (last_good_ && last_good_->whole) last_good_->whole = remapped(last_good_->whole);
   // Too few points left to register to: the next frame starts from its own (as setReference).
   const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
   if (reference_ && reference_->size() < minimum) reference_.reset();
@@ -446,9 +445,7 @@ OdometryUpdate KeyframeOdometry::processLostFrame(double stamp, const std::strin
 OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   checkStamp(frame.stamp);
   source_self_.reset();
-  // An object moving through the view: its region is left out of everything but the judgement
-  // of a split, which needs the whole frame.
-  whole_cloud_ = frame.cloud;
+  const std::size_t cloud_points = frame.cloud ? frame.cloud->size() : 0;
   if (!started_) {
     base_from_camera_ = frame.base_from_camera;
     started_ = true;
@@ -478,9 +475,9 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
       update.moving_region = std::shared_ptr<const PixelRegion>(cloud, cloud->leftOutRegion());
     }
   }
-  if (cloud && whole_cloud_ && whole_cloud_->size() > 0) {
+  if (cloud && cloud_points > 0) {
     update.left_out_share =
-        1.0 - static_cast<double>(cloud->size()) / static_cast<double>(whole_cloud_->size());
+        1.0 - static_cast<double>(cloud->size()) / static_cast<double>(cloud_points);
   }
   update.dt = frame.stamp - reference_stamp_;
   update.frame_interval = frame.stamp - *last_stamp_;
@@ -537,8 +534,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   if (!chosen->good && last_good_ && last_good_->stamp != reference_stamp_) {
     // The keyframe is out of reach: register to the last good frame instead, which is nearer
     // (this frame then becomes the keyframe).
-    const GoodFrame keyframe{reference_, reference_stamp_, reference_pose_, reference_covariance_,
-                             nullptr};
+    const GoodFrame keyframe{reference_, reference_stamp_, reference_pose_, reference_covariance_};
     const bool keyframe_guessed = reference_guessed_;
     const auto keyframe_self = reference_self_;
     const auto keyframe_first_cosine = reference_first_cosine_;
@@ -602,7 +598,7 @@ OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   setReference(cloud, frame.stamp);
   last_trusted_pose_ = pose_;  // the start of the velocity estimate
   last_trusted_stamp_ = frame.stamp;
-  if (reference_) last_good_ = GoodFrame{reference_, frame.stamp, pose_, covariance_, whole_cloud_};
+  if (reference_) last_good_ = GoodFrame{reference_, frame.stamp, pose_, covariance_};
   fillBaseFrame(update, Matrix6d::Identity() * kUnknownVariance);
   update.twist_covariance = Matrix6d::Identity() * kUnknownVariance;
   last_stamp_ = frame.stamp;
@@ -658,7 +654,7 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   lost_frames_ = 0;
   frames_since_anchor_ = 0;
   if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;
-  last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_, whole_cloud_};
+  last_good_ = GoodFrame{frame.cloud, update.stamp, pose_, covariance_};
   update.new_keyframe = wantsKeyframe(update);
   if (update.new_keyframe) {
     setReference(frame.cloud, update.stamp);

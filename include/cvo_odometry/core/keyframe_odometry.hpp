@@ -155,9 +155,6 @@ class KeyframeOdometry {
     double stamp = 0.0;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     Matrix6d covariance = Matrix6d::Zero();
-    // Its cloud before a moving object's region was left out: the fair ground on which a split
-    // between two motions is judged.
-    std::shared_ptr<const LabeledCloud> whole;
   };
   Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
                   double dt);
@@ -211,8 +208,6 @@ class KeyframeOdometry {
   // When something last moved in view: a second motion of its own among the tracks, or tracks
   // that refused a registration.
   std::optional<double> moving_seen_stamp_;
-  // The frame being processed, before its moving region was left out.
-  std::shared_ptr<const LabeledCloud> whole_cloud_;
   std::optional<MotionSplit> split_;  // of the frame being processed, when it was split
   // start <- the frame the processed frame's prior starts from (valid while it has one).
   Eigen::Isometry3d prior_frame_pose_ = Eigen::Isometry3d::Identity();
