@@ -1,0 +1,289 @@
+// Two motions among a frame's tracks (core/motion_split.hpp) on synthetic priors whose tracks
+// follow known motions: a background far away and an object patch near the camera, moving on
+// its own. Which one the scene follows is decided by occlusion, then the depth ratio, then track
+// counts, with the constant-velocity prediction able to veto.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <set>
+#include <utility>
+
+#include "cvo_odometry/core/cvo_params.hpp"
+#include "cvo_odometry/core/motion_split.hpp"
+
+namespace {
+
+constexpr double kFocal = 500.0, kCx = 320.0, kCy = 240.0;
+constexpr int kWidth = 640, kHeight = 480;
+
+// The camera's motion between the frames (previous <- current): 2 cm right, 1 cm forward, a
+// 0.3 degree turn.
+Eigen::Isometry3d cameraMotion() {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.linear() = Eigen::AngleAxisd(0.3 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  m.translation() << 0.02, 0.0, 0.01;
+  return m;
+}
+
+// The motion that explains an object's tracks when the object moved by `moved` (metres, the
+// previous camera's axes) while the camera moved by `camera`: current = camera^-1 (X + moved).
+Eigen::Isometry3d objectMotion(const Eigen::Isometry3d& camera, const Eigen::Vector3d& moved) {
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translation() = -moved;
+  return shift * camera;
+}
+
+struct Scene {
+  cvo::MotionPrior prior;
+  std::vector<int> truth;  // per track: 0 follows prior.motion, 1 prior.second.motion
+};
+
+// A grid of tracks over pixels [u0, u1] x [v0, v1] (previous image) at depth z, every `step` px,
+// moved by `motion` (previous <- current) into the current image.
+void addTracks(Scene* scene, const Eigen::Isometry3d& motion, int which, double u0, double u1,
+               double v0, double v1, double step, double z,
+               const std::function<bool(double, double)>& skip = nullptr) {
+  cvo::MotionPrior& p = scene->prior;
+  const Eigen::Isometry3d current_from_previous = motion.inverse();
+  for (double v = v0; v <= v1 + 1e-9; v += step) {
+    for (double u = u0; u <= u1 + 1e-9; u += step) {
+      if (skip && skip(u, v)) continue;
+      const Eigen::Vector3d X(z * (u - kCx) / kFocal, z * (v - kCy) / kFocal, z);
+      const Eigen::Vector3d c = current_from_previous * X;
+      const Eigen::Vector2d x = c.head<2>() / c.z();
+      p.tracked_points.push_back(X);
+      p.tracked_observations.push_back(x);
+      p.tracked_pixels.emplace_back(static_cast<float>(kFocal * x.x() + kCx),
+                                    static_cast<float>(kFocal * x.y() + kCy));
+      scene->truth.push_back(which);
+    }
+  }
+}
+
+Scene emptyScene(const Eigen::Isometry3d& first, const Eigen::Isometry3d& second) {
+  Scene scene;
+  cvo::MotionPrior& p = scene.prior;
+  p.solved = true;
+  p.motion = first;
+  p.second.solved = true;
+  p.second.motion = second;
+  p.focal_px = kFocal;
+  p.inlier_px = 1.5;
+  p.image_width = kWidth;
+  p.image_height = kHeight;
+  return scene;
+}
+
+// The object (1 m away, a dense patch in the middle: more tracks than the background) in front
+// of the background (4 m, sparse, all around it): the object's tracks neighbour the
+// background's. The object's motion comes first, as PnP on the majority would give it.
+Scene occludingObject() {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d object = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
+  Scene scene = emptyScene(object, camera);
+  const double u0 = 240, u1 = 400, v0 = 160, v1 = 320;
+  addTracks(&scene, object, 0, u0, u1, v0, v1, 10.0, 1.0);
+  addTracks(&scene, camera, 1, 20, 620, 20, 460, 40.0, 4.0, [&](double u, double v) {
+    return u >= u0 - 5 && u <= u1 + 5 && v >= v0 - 5 && v <= v1 + 5;  // hidden behind it
+  });
+  return scene;
+}
+
+// The object (1 m) and the background (4 m) in separate parts of the image, more than the
+// neighbour reach (7.5 % of the width) apart: only the depth ratio tells them apart. The
+// background's motion comes first.
+Scene separateObject() {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d object = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
+  Scene scene = emptyScene(camera, object);
+  addTracks(&scene, camera, 0, 20, 300, 20, 460, 20.0, 4.0);
+  addTracks(&scene, object, 1, 440, 600, 160, 320, 20.0, 1.0);
+  return scene;
+}
+
+// Both at 2 m, apart in the image: `first_count` and `second_count` tracks (rows of 10).
+Scene similarDepths(int first_count, int second_count) {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d object = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
+  Scene scene = emptyScene(camera, object);
+  const auto rows = [](int count) { return (count + 9) / 10; };
+  addTracks(&scene, camera, 0, 20, 200, 20, 20 + 20.0 * (rows(first_count) - 1), 20.0, 2.0);
+  addTracks(&scene, object, 1, 400, 580, 20, 20 + 20.0 * (rows(second_count) - 1), 20.0, 2.0);
+  return scene;
+}
+
+int count(const std::vector<int>& v, int value) {
+  return static_cast<int>(std::count(v.begin(), v.end(), value));
+}
+
+const cvo::CvoParams kParams;  // the odometry's own ratios
+
+cvo::MotionSplit split(const cvo::MotionPrior& prior,
+                       const std::optional<Eigen::Isometry3d>& predicted = std::nullopt,
+                       double depth_ratio = kParams.motion_split_depth_ratio) {
+  return cvo::splitMotions(prior, depth_ratio, kParams.motion_split_ratio, predicted);
+}
+
+// Proves: each track goes to the motion that moved it; occlusion between neighbouring tracks
+// names the background (the tracks behind) even when the object holds more tracks, and wins
+// over a constant-velocity prediction that points at the object and over a depth ratio that
+// cannot be met.
+TEST(MotionSplit, OcclusionPicksTheTracksBehindEvenWhenTheObjectHoldsMore) {
+  const Scene scene = occludingObject();
+  const int object_tracks = count(scene.truth, 0), background_tracks = count(scene.truth, 1);
+  ASSERT_GT(object_tracks, background_tracks) << "the object must hold more tracks";
+  ASSERT_GT(background_tracks, 50);
+
+  const cvo::MotionSplit s = split(scene.prior);
+  EXPECT_EQ(s.owner, scene.truth) << "each track to the motion that moved it";
+  EXPECT_EQ(s.first_tracks, object_tracks);
+  EXPECT_EQ(s.second_tracks, background_tracks);
+  EXPECT_NEAR(s.first_depth, 1.0, 1e-9);
+  EXPECT_NEAR(s.second_depth, 4.0, 1e-9);
+  EXPECT_EQ(s.scene, cvo::SceneMotion::kSecond) << s.why;
+  EXPECT_NE(s.why.find("in front"), std::string::npos) << s.why;
+
+  // The object's own motion as the prediction: occlusion is the stronger evidence.
+  const cvo::MotionSplit vetoed = split(scene.prior, scene.prior.motion);
+  EXPECT_EQ(vetoed.scene, cvo::SceneMotion::kSecond) << vetoed.why;
+  // A depth ratio no median meets: occlusion alone still decides.
+  const cvo::MotionSplit strict = split(scene.prior, std::nullopt, 100.0);
+  EXPECT_EQ(strict.scene, cvo::SceneMotion::kSecond) << strict.why;
+}
+
+// Proves: without neighbouring tracks the farther tracks' motion is the scene's by the depth
+// ratio, whichever holds more tracks, but a constant-velocity prediction clearly nearer the
+// other motion leaves it undecided (the frame must not be trusted); a prediction nearer the
+// farther motion, or one that is clearly nearer neither, leaves the depth ratio's word.
+TEST(MotionSplit, DepthRatioAloneGivesWayToAPredictionNearTheOtherMotion) {
+  const Scene scene = separateObject();
+  const cvo::MotionSplit plain = split(scene.prior);
+  EXPECT_EQ(plain.owner, scene.truth);
+  EXPECT_EQ(plain.why.find("in front"), std::string::npos) << "no neighbours: " << plain.why;
+  EXPECT_EQ(plain.scene, cvo::SceneMotion::kFirst) << plain.why;
+
+  const cvo::MotionSplit against = split(scene.prior, scene.prior.second.motion);
+  EXPECT_EQ(against.scene, cvo::SceneMotion::kUndecided) << against.why;
+  EXPECT_NE(against.why.find("constant-velocity prediction"), std::string::npos) << against.why;
+
+  const cvo::MotionSplit agreeing = split(scene.prior, scene.prior.motion);
+  EXPECT_EQ(agreeing.scene, cvo::SceneMotion::kFirst) << agreeing.why;
+
+  // Halfway between the two motions: near neither clearly, the depth ratio decides.
+  Eigen::Isometry3d halfway = scene.prior.motion;
+  halfway.translation() =
+      0.5 * (scene.prior.motion.translation() + scene.prior.second.motion.translation());
+  const cvo::MotionSplit unclear = split(scene.prior, halfway);
+  EXPECT_EQ(unclear.scene, cvo::SceneMotion::kFirst) << unclear.why;
+}
+
+// Proves: at similar depths a lopsided split picks the motion with far more tracks (first or
+// second), a prediction nearer the smaller one vetoes it, and a balanced split is undecided
+// unless the prediction is nearer the motion with more tracks.
+TEST(MotionSplit, LopsidedSplitAtSimilarDepthsPicksTheLarger) {
+  const Scene first_larger = similarDepths(100, 20);
+  const cvo::MotionSplit a = split(first_larger.prior);
+  EXPECT_EQ(a.owner, first_larger.truth);
+  ASSERT_EQ(a.first_tracks, 100);
+  ASSERT_EQ(a.second_tracks, 20);
+  EXPECT_EQ(a.scene, cvo::SceneMotion::kFirst) << a.why;
+
+  const Scene second_larger = similarDepths(20, 100);
+  const cvo::MotionSplit b = split(second_larger.prior);
+  EXPECT_EQ(b.scene, cvo::SceneMotion::kSecond) << b.why;
+  // The prediction at the smaller one's motion: undecided.
+  const cvo::MotionSplit vetoed = split(second_larger.prior, second_larger.prior.motion);
+  EXPECT_EQ(vetoed.scene, cvo::SceneMotion::kUndecided) << vetoed.why;
+
+  const Scene balanced = similarDepths(60, 50);
+  const cvo::MotionSplit c = split(balanced.prior);
+  EXPECT_EQ(c.scene, cvo::SceneMotion::kUndecided) << c.why;
+  const cvo::MotionSplit d = split(balanced.prior, balanced.prior.motion);
+  EXPECT_EQ(d.scene, cvo::SceneMotion::kFirst) << d.why;
+  const cvo::MotionSplit e = split(balanced.prior, balanced.prior.second.motion);
+  EXPECT_EQ(e.scene, cvo::SceneMotion::kUndecided) << e.why;
+}
+
+// Proves: sceneFirst puts the scene's motion first (swapping when the scene follows the second)
+// and gives each motion its own tracks only: the inlier set is the scene's tracks, the second
+// motion's pixels the object's, no track in both.
+TEST(MotionSplit, SceneFirstSwapsMotionsAndGivesExclusiveInlierSets) {
+  const Scene scene = occludingObject();
+  const cvo::MotionSplit s = split(scene.prior);
+  ASSERT_EQ(s.scene, cvo::SceneMotion::kSecond) << s.why;
+  const cvo::MotionPrior out = cvo::sceneFirst(scene.prior, s);
+  EXPECT_TRUE(out.motion.isApprox(scene.prior.second.motion, 1e-12)) << "swapped";
+  EXPECT_TRUE(out.second.motion.isApprox(scene.prior.motion, 1e-12));
+  ASSERT_EQ(out.inliers, s.second_tracks);
+  ASSERT_EQ(static_cast<int>(out.points.size()), s.second_tracks);
+  ASSERT_EQ(out.inlier_pixels.size(), out.points.size());
+  ASSERT_EQ(out.observations.size(), out.points.size());
+  EXPECT_EQ(out.second.inliers, s.first_tracks);
+  ASSERT_EQ(static_cast<int>(out.second.pixels.size()), s.first_tracks);
+  EXPECT_NEAR(out.inlier_ratio,
+              static_cast<double>(s.second_tracks) / scene.prior.tracked_points.size(), 1e-12);
+  // The background's points (4 m) are the inliers, the object's pixels the second's.
+  for (const Eigen::Vector3d& X : out.points)
+    EXPECT_NEAR(X.z(), 4.0, 1e-9);
+  std::set<std::pair<float, float>> background, object;
+  for (std::size_t k = 0; k < scene.truth.size(); ++k) {
+    const auto px =
+        std::make_pair(scene.prior.tracked_pixels[k].x(), scene.prior.tracked_pixels[k].y());
+    (scene.truth[k] == 1 ? background : object).insert(px);
+  }
+  std::set<std::pair<float, float>> inliers;
+  for (const auto& p : out.inlier_pixels) {
+    inliers.insert({p.x(), p.y()});
+    EXPECT_EQ(background.count({p.x(), p.y()}), 1u) << "an inlier pixel not the background's";
+  }
+  for (const auto& p : out.second.pixels) {
+    EXPECT_EQ(object.count({p.x(), p.y()}), 1u) << "a second-motion pixel not the object's";
+    EXPECT_EQ(inliers.count({p.x(), p.y()}), 0u) << "a pixel in both sets";
+  }
+  // The scene's inliers agree with the scene's motion, not the object's.
+  EXPECT_DOUBLE_EQ(cvo::trackAgreement(out, out.motion, 0.5).fraction, 1.0);
+  EXPECT_LT(cvo::trackAgreement(out, out.second.motion, 1.5).fraction, 0.05);
+
+  // The scene first already: nothing swapped, the first motion's tracks the inliers.
+  const Scene separate = separateObject();
+  const cvo::MotionSplit t = split(separate.prior);
+  ASSERT_EQ(t.scene, cvo::SceneMotion::kFirst) << t.why;
+  const cvo::MotionPrior kept = cvo::sceneFirst(separate.prior, t);
+  EXPECT_TRUE(kept.motion.isApprox(separate.prior.motion, 1e-12));
+  EXPECT_TRUE(kept.second.motion.isApprox(separate.prior.second.motion, 1e-12));
+  EXPECT_EQ(kept.inliers, t.first_tracks);
+  EXPECT_EQ(kept.second.inliers, t.second_tracks);
+}
+
+// Proves: motionsApartPx is 0 for equal motions, symmetric, and grows with the motions'
+// difference (about in proportion for small differences).
+TEST(MotionSplit, MotionsApartGrowsWithTheirDifference) {
+  const Scene scene = separateObject();
+  const Eigen::Isometry3d camera = cameraMotion();
+  EXPECT_EQ(cvo::motionsApartPx(scene.prior, camera, camera), 0.0);
+  double last = 0.0;
+  std::vector<double> apart;
+  for (const double cm : {0.5, 1.0, 2.0, 4.0, 8.0}) {
+    const Eigen::Isometry3d other = objectMotion(camera, Eigen::Vector3d(0.01 * cm, 0.0, 0.0));
+    const double d = cvo::motionsApartPx(scene.prior, camera, other);
+    EXPECT_GT(d, last) << cm << " cm";
+    EXPECT_NEAR(cvo::motionsApartPx(scene.prior, other, camera), d, 1e-6 * d) << "symmetric";
+    apart.push_back(d);
+    last = d;
+  }
+  EXPECT_NEAR(apart[1] / apart[0], 2.0, 0.1);
+  EXPECT_NEAR(apart[2] / apart[1], 2.0, 0.1);
+  // A turn counts too: 1 degree moves every point at least focal * 1 deg (in radians) px, more
+  // off the axis (by 1 + x^2, x <= 0.6 here).
+  Eigen::Isometry3d turned = camera;
+  turned.linear() = camera.linear() *
+                    Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const double turn = cvo::motionsApartPx(scene.prior, camera, turned);
+  EXPECT_GT(turn, 0.99 * kFocal * M_PI / 180.0);
+  EXPECT_LT(turn, 1.4 * kFocal * M_PI / 180.0);
+}
+
+}  // namespace
