@@ -210,6 +210,7 @@ int MovingObject::render(const Eigen::Isometry3d& camera_from_object, cv::Mat* i
 cv::Mat MovingObject::labels(const cv::Mat& mask) const {
   cv::Mat changed = mask;
   if (spec_.label_error_px != 0) {
+    changed = cv::Mat();  // a new image: the caller's mask stays the object's
     const int n = std::abs(spec_.label_error_px);
     const cv::Mat disc =
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * n + 1, 2 * n + 1));

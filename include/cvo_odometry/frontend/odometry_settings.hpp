@@ -109,8 +109,8 @@ void visitSettings(OdometrySettings& s, V&& v) {
     s.features.min_distance);
   v(SettingInfo{"feature_grid", "features",
                 "corners spread over square cells, this many across the image, none holding more "
-                "than its share (0: off): a corner-rich moving object holds no more of the tracks "
-                "than of the image",
+                "than its share (0: off): a corner-rich moving object cannot take nearly all "
+                "tracks",
                 0, 1000},
     s.features.grid_columns);
   v(SettingInfo{"klt_window", "features", "KLT window (px)", 5, 101}, s.features.window);
