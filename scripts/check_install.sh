@@ -15,7 +15,8 @@
 #          checks an install space already there (e.g. a workspace's install/ after
 #          `catkin_make install`) of the package in DIR (default: this checkout), hiding the
 #          DIRs (e.g. the workspace's src/, build/ and devel/) too
-# Options: --keep (keep the temporary folder), --no-replay (skip the bag replay: ~20 s)
+# Options: --keep (keep the temporary folder, which a failure keeps anyway for its logs),
+#          --no-replay (skip the bag replay: ~20 s)
 # Prints a line per check; exits non-zero at the first failure with one line saying what failed.
 set -euo pipefail
 source "$(dirname "$0")/env.sh"
@@ -43,9 +44,6 @@ done
 
 fail() { echo "install check FAILED: $*" >&2; exit 1; }
 work=$(mktemp -d "${TMPDIR:-/tmp}/cvo_install_check.XXXXXX")
-if [ "$keep" = false ]; then
-  trap 'rm -rf "$work"' EXIT
-fi
 
 if [ -n "$build" ]; then
   [ -f "$build/CMakeCache.txt" ] || fail "$build is not a configured build folder (no CMakeCache.txt)"
@@ -232,3 +230,4 @@ else
   "${clean_env[@]}" bash "$work/inner.sh"
 fi
 echo "install check passed: $prefix"
+[ "$keep" = true ] || rm -rf "$work"

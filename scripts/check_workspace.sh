@@ -9,7 +9,8 @@
 # Usage: scripts/check_workspace.sh [--tool catkin_make|catkin] [--ws DIR] [--keep]
 #                                   [--run-tests] [-- CMAKE_ARGS...]
 #   --tool     catkin_make (default) or catkin (catkin-tools: catkin build)
-#   --ws DIR   the workspace (default: a new temporary folder, removed afterwards unless --keep);
+#   --ws DIR   the workspace (default: a new temporary folder, removed after a pass unless --keep,
+#              kept after a failure for its logs);
 #              an existing DIR/src/cvo_odometry is replaced by a copy of this checkout
 #   --run-tests  also `catkin_make run_tests` and catkin_test_results (builds every test: long)
 #   CMAKE_ARGS e.g. -DCVO_WITH_CUDA=OFF, -DCMAKE_CUDA_ARCHITECTURES=86
@@ -34,15 +35,16 @@ while [ $# -gt 0 ]; do
 done
 case "$tool" in catkin_make|catkin) ;; *) usage ;; esac
 
-fail() { echo "workspace check FAILED: $*" >&2; exit 1; }
+fail() { echo "workspace check FAILED: $* (workspace: ${ws:-none})" >&2; exit 1; }
 step_start=$SECONDS
 step() { echo "workspace: $* ($((SECONDS - step_start)) s)"; step_start=$SECONDS; }
 
 "$CVO_ROOT/scripts/install_deps.sh" full
 [ "$tool" = catkin_make ] || "$CVO_ROOT/scripts/install_deps.sh" tools
+temporary=false
 if [ -z "$ws" ]; then
   ws=$(mktemp -d "${TMPDIR:-/tmp}/cvo_ws.XXXXXX")
-  [ "$keep" = true ] || trap 'rm -rf "$ws"' EXIT
+  temporary=true
 fi
 mkdir -p "$ws/src"
 ws=$(cd "$ws" && pwd)
@@ -72,7 +74,7 @@ grep -h "cvo_odometry:" "$log/build.log" | sed 's/^ *-- */  /' || true
 step "$tool built the workspace"
 
 # The devel space: roslaunch cvo_odometry rgbd.launch, until the nodelet's services are up (or a
-# node dies or logs FATAL).
+# node dies or logs FATAL, or CVO_ROSLAUNCH_LIMIT s pass: a hang).
 port=$(cvo_free_port)
 devel_check=$(cat <<EOF
 set -euo pipefail
@@ -90,6 +92,8 @@ while kill -0 \$launch 2>/dev/null; do
     break
   fi
   grep -qE 'has died|\[FATAL\]' "$log/rgbd_launch.log" && break
+  # A bound only a hang reaches (as in scripts/env.sh's cvo_roslaunch_logged).
+  [ \$SECONDS -lt ${CVO_ROSLAUNCH_LIMIT:-900} ] || { echo "not up after \$SECONDS s: stopped" >>"$log/rgbd_launch.log"; break; }
   sleep 1
 done
 kill -INT \$launch 2>/dev/null || true
@@ -123,3 +127,7 @@ if [ "$run_tests" = true ]; then
   step "catkin_make run_tests: every test passed"
 fi
 echo "workspace check passed: $ws"
+if [ "$temporary" = true ] && [ "$keep" = false ]; then
+  cd /
+  rm -rf "$ws"
+fi
