@@ -204,10 +204,10 @@ MotionPrior FeatureTracker::track(const cv::Mat& grey, const cv::Mat& depth,
     throw std::invalid_argument("the excluded pixels' mask must be 8-bit, of the image's size");
   }
   // A corner whose KLT window reaches an excluded object is dragged along by it: corners and
-  // tracks keep a window's width further away than the cloud does.
+  // tracks keep half a window further away than the cloud does.
   cv::Mat kept_away;
   if (!excluded.empty() && cv::countNonZero(excluded) > 0) {
-    const int side = 2 * options_.window + 1;
+    const int side = options_.window | 1;
     cv::dilate(excluded, kept_away,
                cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side)));
   }
