@@ -4,11 +4,28 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <string>
 
 #include "cvo_odometry/ros/node_settings.hpp"
 
+namespace {
+
+const char* kUsage =
+    "usage: cvo_settings_table [FILE]\n"
+    "  prints every parameter (name, type, default, range, meaning) as a markdown table; with\n"
+    "  FILE, rewrites the table between its \"<!-- settings table -->\" and\n"
+    "  \"<!-- end settings table -->\" lines instead (README.md)\n";
+
+}  // namespace
+
 int main(int argc, char** argv) {
   const std::string table = cvo::settingsMarkdown(cvo::NodeSettings());
+  if (argc > 2 || (argc == 2 && std::string(argv[1]).rfind("-", 0) == 0)) {
+    const bool help =
+        argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h");
+    (help ? std::cout : std::cerr) << kUsage;
+    return help ? 0 : 2;
+  }
   if (argc < 2) {
     std::cout << table;
     return 0;
