@@ -60,6 +60,30 @@ for page in "$readme" doc/*.md; do
   done
 done
 
+# 5b. Anchors (#section) of links within README.md and doc/ name a heading of their page (GitHub's
+#     rule: lower case, punctuation dropped, spaces to dashes).
+while IFS= read -r problem; do
+  fail "$problem"
+done < <(python3 - "$readme" doc/*.md <<'PY'
+import os, re, sys
+def slugs(page):
+    out = set()
+    for line in open(page):
+        m = re.match(r"#+ (.*)", line)
+        if m:
+            text = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower().replace("`", ""))
+            out.add(text.replace(" ", "-"))
+    return out
+for page in sys.argv[1:]:
+    if not os.path.isfile(page):
+        continue
+    for target, anchor in re.findall(r"\]\(([^)#: ]*)#([^) ]+)\)", open(page).read()):
+        path = os.path.normpath(os.path.join(os.path.dirname(page), target)) if target else page
+        if os.path.isfile(path) and anchor not in slugs(path):
+            print(f"{page}: link to {target}#{anchor}: no such heading")
+PY
+)
+
 # 6. Generated blocks are closed, one end per start (doc/regenerate.sh).
 for page in "$readme" doc/*.md; do
   [ -f "$page" ] || continue
