@@ -90,6 +90,22 @@ peer_cell() {
        END { printf "%.2f|%.3f|%s\n", mm, deg, s }' "$1"
 }
 
+# The OpenCV peers' cells, "mm|deg|silent|mm|deg|silent", on a sequence (none without peers).
+peer_cells() {
+  local kind=$1 dir=$2 gt=$3 cells=() method
+  $peers_on || return 0
+  for method in opencv_rgbd opencv_icp; do
+    "$peers" "--$kind" "$dir" --method "$method" --out "$work/$method.txt" \
+      >"$work/$method.out" 2>"$work/$method.log" || { cat "$work/$method.log" >&2; exit 1; }
+    local times=()
+    [ "$kind" = kitti ] && times=(--gt-times "$dir/times.txt" --est-times "$dir/times.txt")
+    "$evaluate" --gt "$gt" --est "$work/$method.txt" --all-trusted "${times[@]}" \
+      >"$work/$method.eval" 2>&1 || { cat "$work/$method.eval" >&2; exit 1; }
+    cells+=("$(peer_cell "$work/$method.eval")")
+  done
+  (IFS='|'; echo "${cells[*]}")
+}
+
 failed=0
 rows=()
 run_case() {
@@ -115,20 +131,7 @@ run_case() {
       grep -q "^tracking:" "$work/$variant.log" || { tail -5 "$work/$variant.log" >&2; exit 1; }
     ours+=("$(ours_cell "$work/$variant.log")")
   done
-  local peer_cells=()
-  if $peers_on; then
-    local method
-    for method in opencv_rgbd opencv_icp; do
-      "$peers" "--$kind" "$dir" --method "$method" --out "$work/$method.txt" \
-        >"$work/$method.out" 2>"$work/$method.log" || { cat "$work/$method.log" >&2; exit 1; }
-      local times=()
-      [ "$kind" = kitti ] && times=(--gt-times "$dir/times.txt" --est-times "$dir/times.txt")
-      "$evaluate" --gt "$gt" --est "$work/$method.txt" --all-trusted "${times[@]}" \
-        >"$work/$method.eval" 2>&1 || { cat "$work/$method.eval" >&2; exit 1; }
-      peer_cells+=("$(peer_cell "$work/$method.eval")")
-    done
-  fi
-  rows+=("$name|$covers|${ours[0]}|${ours[1]}|$(IFS='|'; echo "${peer_cells[*]:-}")")
+  rows+=("$name|$covers|${ours[0]}|${ours[1]}|$(peer_cells "$kind" "$dir" "$gt")")
   if $check; then
     local silent_u silent_l lost_l
     silent_u=$(echo "${ours[0]}" | cut -d'|' -f4)
@@ -150,20 +153,7 @@ static_row() {
     { tail -5 "$work/static.log" >&2; exit 1; }
   local cell
   cell=$(ours_cell "$work/static.log")
-  local peer_cells=()
-  if $peers_on; then
-    local method
-    for method in opencv_rgbd opencv_icp; do
-      "$peers" "--$kind" "$source" --method "$method" --out "$work/$method.txt" \
-        >"$work/$method.out" 2>"$work/$method.log" || { cat "$work/$method.log" >&2; exit 1; }
-      local times=()
-      [ "$kind" = kitti ] && times=(--gt-times "$source/times.txt" --est-times "$source/times.txt")
-      "$evaluate" --gt "$gt" --est "$work/$method.txt" --all-trusted "${times[@]}" \
-        >"$work/$method.eval" 2>&1 || { cat "$work/$method.eval" >&2; exit 1; }
-      peer_cells+=("$(peer_cell "$work/$method.eval")")
-    done
-  fi
-  rows+=("$kind without an object|-|$cell|-|-|-|-|$(IFS='|'; echo "${peer_cells[*]:-}")")
+  rows+=("$kind without an object|-|$cell|-|-|-|-|$(peer_cells "$kind" "$source" "$gt")")
 }
 
 static_row tum "$tum" "$tum/groundtruth.txt"
