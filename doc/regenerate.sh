@@ -2,9 +2,12 @@
 # Regenerates the tables of README.md and doc/*.md from the scripts that measure them. Each
 # generated block of a page is
 #     <!-- generated: COMMAND -->
-#     ...COMMAND's standard output, exactly...
+#     ...COMMAND's standard output...
 #     <!-- end generated -->
-# and is replaced by a new run of COMMAND (bash, in the repository root). A command that fails
+# and is replaced by a new run of COMMAND (bash, in the repository root): its output as it is,
+# but for a blank line put between a markdown table and text that follows it (which would
+# otherwise read as a row). "<!-- generated text: COMMAND -->" puts the output in a ```text
+# block, for output in plain columns. A command that fails
 # (e.g. no KITTI folder, no GPU) leaves its block as it was; the script then says which and exits 1.
 # Nothing outside the blocks is touched: prose that quotes a figure names its table.
 #
@@ -59,7 +62,7 @@ for page in "${pages[@]}"; do
 import os, subprocess, sys, time
 
 page = sys.argv[1]
-begin, end = "<!-- generated: ", "<!-- end generated -->"
+begins, end = ("<!-- generated: ", "<!-- generated text: "), "<!-- end generated -->"
 listing = os.environ["CVO_REGENERATE_LIST"] == "true"
 only = os.environ["CVO_REGENERATE_ONLY"]
 with open(page) as f:
@@ -69,7 +72,8 @@ while i < len(lines):
     line = lines[i]
     out.append(line)
     i += 1
-    if not (line.startswith(begin) and line.endswith(" -->")):
+    begin = next((b for b in begins if line.startswith(b)), None)
+    if begin is None or not line.endswith(" -->"):
         continue
     command = line[len(begin):-len(" -->")]
     j = i
@@ -96,7 +100,18 @@ while i < len(lines):
             out.extend(old)
         else:
             print(f"{page}: done in {took:.0f} s", file=sys.stderr)
-            out.extend(run.stdout.rstrip("\n").split("\n"))
+            new = run.stdout.rstrip("\n").split("\n")
+            if begin == begins[1]:
+                new = ["```text"] + new + ["```"]
+            else:
+                spaced = []
+                for k, text in enumerate(new):
+                    spaced.append(text)
+                    following = new[k + 1] if k + 1 < len(new) else ""
+                    if text.startswith("|") and following and not following.startswith("|"):
+                        spaced.append("")
+                new = spaced
+            out.extend(new)
     out.append(end)
     i = j + 1
 if not listing:

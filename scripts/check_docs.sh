@@ -87,7 +87,7 @@ PY
 # 6. Generated blocks are closed, one end per start (doc/regenerate.sh).
 for page in "$readme" doc/*.md; do
   [ -f "$page" ] || continue
-  starts=$(grep -c '^<!-- generated: .* -->$' "$page")
+  starts=$(grep -cE '^<!-- generated( text)?: .* -->$' "$page")
   ends=$(grep -c '^<!-- end generated -->$' "$page")
   [ "$starts" = "$ends" ] || fail "$page: $starts generated blocks opened, $ends closed"
 done
