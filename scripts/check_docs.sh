@@ -7,9 +7,10 @@
 # its own, a few seconds.
 #
 # Usage: scripts/check_docs.sh [BUILD_DIR]
-#   BUILD_DIR  a build of this package (e.g. build/): its tools must answer --help; without it
-#              that check is skipped (the tools are looked for in BUILD_DIR/devel/lib/cvo_odometry,
-#              else anywhere below BUILD_DIR)
+#   BUILD_DIR  a build of this package (e.g. build/): the tools built there must answer --help
+#              (looked for in BUILD_DIR/devel/lib/cvo_odometry, else anywhere below BUILD_DIR; one
+#              not built, e.g. cvo_make_bag in a build without ROS, is noted); without BUILD_DIR
+#              that check is skipped
 # Prints one line per problem and a summary; exits 1 when anything failed.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -110,7 +111,7 @@ if [ -n "$build" ]; then
     exe="$build/devel/lib/cvo_odometry/$tool"
     [ -x "$exe" ] || exe=$(find "$build" -name "$tool" -type f -perm -u+x 2>/dev/null | head -1)
     if [ -z "$exe" ] || [ ! -x "$exe" ]; then
-      fail "tool $tool is not built in $build"
+      echo "check_docs: note: $tool is not built in $build (--help not checked)"
       continue
     fi
     out=$("$exe" --help 2>&1) && [ -n "$out" ] || fail "$tool --help failed: $(head -1 <<<"$out")"
