@@ -243,6 +243,10 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     if (scene_tracks && result.update.moving_region) {
       scene_tracks = withoutTracksIn(*scene_tracks, *result.update.moving_region);
     }
+    // Depth matched at points only: the tracks' pixels get theirs (nothing to do when dense).
+    if (scene_tracks && settings_.estimate_disparity_offset) {
+      stereo_builder_->completeTrackDepth(*scene_tracks, stereo->intrinsics);
+    }
     if (offset_calibration_->update(
             *stereo, images.depth, scene_tracks,
             result.update.trusted() && !result.update.firstFrame() && from_previous)) {

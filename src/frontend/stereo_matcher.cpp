@@ -28,6 +28,14 @@ void StereoMatcherOptions::validate() const {
   if (mode != "sgbm" && mode != "hh" && mode != "sgbm_3way") {
     throw std::invalid_argument("unknown SGBM mode '" + mode + "' (sgbm, hh or sgbm_3way)");
   }
+  if (depth != "dense" && depth != "quarter" && depth != "half" && depth != "sparse") {
+    throw std::invalid_argument("unknown stereo_depth '" + depth +
+                                "' (dense, quarter, half or sparse)");
+  }
+}
+
+int StereoMatcherOptions::pointLevel() const {
+  return depth == "quarter" ? 2 : depth == "half" ? 1 : depth == "sparse" ? 0 : -1;
 }
 
 int StereoMatcherOptions::minImageWidth() const {

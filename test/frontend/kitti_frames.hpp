@@ -2,6 +2,11 @@
 // a given front end, and the calibration published with kitti_stereo_pair.
 #pragma once
 
+#include <cmath>
+#include <string>
+
+#include "cvo_odometry/core/cvo_registration.hpp"
+#include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
 
@@ -31,6 +36,30 @@ inline cvo::StereoFrame kittiFrame(const cvo::KittiSequence& sequence, std::size
 inline cvo::LabeledCloud kittiCloud(const cvo::KittiSequence& sequence,
                                     cvo::StereoCloudBuilder& builder, std::size_t k) {
   return builder.build(kittiFrame(sequence, k));
+}
+
+// Clouds of frames 0 and 1 of the sequence in `folder` through `builder`, registered on the CPU
+// with `params` from the identity: the result's error against the ground truth's motion.
+struct RegistrationError {
+  bool converged = false;
+  std::string message;
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+  double step_m = 0.0;  // the ground truth's translation
+};
+inline RegistrationError firstStepError(const std::string& folder,
+                                        cvo::StereoCloudBuilder& builder, cvo::CvoParams params) {
+  const cvo::KittiSequence sequence(folder);
+  const auto target = kittiCloud(sequence, builder, 0);
+  const auto source = kittiCloud(sequence, builder, 1);
+  const auto gt = cvo::readKittiTrajectory(folder + "/poses.txt");
+  const Eigen::Isometry3d truth = gt[0].pose.inverse() * gt[1].pose;
+  params.backend = cvo::BackendChoice::kCpu;
+  cvo::CvoRegistration registration(params);
+  const auto result = registration.align(target, source, Eigen::Isometry3d::Identity(), true);
+  const Eigen::Isometry3d error = truth.inverse() * result.transform;
+  return {result.report.converged, result.report.message, error.translation().norm(),
+          Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI, truth.translation().norm()};
 }
 
 }  // namespace cvo_test

@@ -98,6 +98,11 @@ void visitSettings(OdometrySettings& s, V&& v) {
     s.disparity_offset_estimate.max_standard_error);
   v(SettingInfo{"sgbm_mode", "stereo", "SGBM variant: sgbm, hh (8 paths) or sgbm_3way (threaded)"},
     s.stereo.mode);
+  v(SettingInfo{"stereo_depth", "stereo",
+                "where stereo depth is matched: dense (SGBM at every pixel), quarter or half (at "
+                "the pixels the front end uses, around SGBM at 1/4 or 1/2 resolution) or sparse "
+                "(those pixels, the whole range searched)"},
+    s.stereo.depth);
   v(SettingInfo{"feature_prior", "features",
                 "track the previous frame's corners (KLT + PnP): a motion guess and a check "
                 "independent of CVO"},

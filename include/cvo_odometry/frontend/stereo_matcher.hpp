@@ -22,8 +22,19 @@ struct StereoMatcherOptions {
   // sgbm | hh | sgbm_3way. sgbm_3way: OpenCV's multi-threaded variant; on KITTI 06 here it is
   // 2.6x faster than sgbm with lower odometry error (README, the KITTI accuracy table).
   std::string mode = "sgbm_3way";
+  // Where the stereo front end computes depth (StereoCloudBuilder):
+  //   dense: SGBM (the options above) at every pixel of the rows below the crop;
+  //   quarter, half: at the pixels the front end uses only (FAST corners for the cloud and the
+  //     feature tracker, the tracks' neighbourhoods for the disparity offset estimate), each
+  //     searched around the disparity of SGBM at 1/4 or 1/2 of the resolution, with sub-pixel
+  //     refinement and a left-right check (PointStereoMatcher);
+  //   sparse: at those pixels, the whole disparity range searched at each (no SGBM at all).
+  // The point modes leave every other pixel without depth (NaN).
+  std::string depth = "dense";
 
   void validate() const;
+  // The coarse level of a point mode (quarter 2, half 1, sparse 0); -1 for dense.
+  int pointLevel() const;
 
   // The narrowest pair OpenCV 4.6's StereoSGBM can match with these options, in every mode
   // (modules/calib3d/src/stereosgbm.cpp): the matching band, columns minX1 = max(min_disparity
