@@ -45,7 +45,9 @@ const char* kUsage =
     "  --label N           its class id (1)\n"
     "  --label-error PX    > 0: the labels miss PX of its outline; < 0: they spill PX over (0)\n"
     "  --camera NAME       TUM intrinsics as for cvo_run_sequence (fr1)\n"
-    "  --max-gap S         ground truth at most this far from a frame's stamp (0.05)\n";
+    "  --max-gap S         ground truth at most this far from a frame's stamp (0.05)\n"
+    "  --labels-only       the labels of the object, the images left as recorded (the error of\n"
+    "                      a labelled run with that part of the view hidden and nothing moving)\n";
 
 struct Summary {
   std::vector<double> coverage;
@@ -145,8 +147,10 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
     // Colour and labels at the colour image's time, depth at the depth image's: each shows the
     // object where it was when that image was taken.
     cv::Mat mask;
-    object.render(object.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp, max_gap)), &image,
-                  nullptr, &mask);
+    const bool labels_only = cli.has("labels-only");
+    cv::Mat painted = labels_only ? image.clone() : image;  // a scratch canvas for labels only
+    object.render(object.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp, max_gap)),
+                  &painted, nullptr, &mask);
     cv::Mat object_depth;
     cv::Mat depth_image = image.clone();  // a scratch canvas; only the depth is kept
     object.render(object.cameraFromObject(f.depth_stamp, poseAt(truth, f.depth_stamp, max_gap)),
@@ -154,7 +158,7 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {
         const float z = object_depth.at<float>(v, u);
-        if (std::isfinite(z)) {
+        if (std::isfinite(z) && !labels_only) {
           depth.at<std::uint16_t>(v, u) = cv::saturate_cast<std::uint16_t>(z * kUnitsPerMetre);
         }
       }
@@ -202,8 +206,13 @@ void makeKitti(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, c
         object.cameraFromObject(stamp, poseAt(truth, stamp, max_gap));
     // Both cameras see the same board: a disparity consistent with its depth.
     cv::Mat mask;
-    object.render(camera_from_object, &left, nullptr, &mask);
-    object.render(camera_from_object, &right, nullptr, nullptr, calibration.baseline);
+    if (cli.has("labels-only")) {
+      cv::Mat scratch = left.clone();
+      object.render(camera_from_object, &scratch, nullptr, &mask);
+    } else {
+      object.render(camera_from_object, &left, nullptr, &mask);
+      object.render(camera_from_object, &right, nullptr, nullptr, calibration.baseline);
+    }
     const std::string name = sequence.imageName(k);
     writeImage(out / "image_0" / name, left);
     writeImage(out / "image_1" / name, right);
@@ -225,7 +234,7 @@ int main(int argc, char** argv) {
         argc, argv,
         {"tum", "kitti", "out", "area", "aspect", "depth", "start", "velocity", "shape", "texture",
          "seed", "label", "label-error", "camera", "max-gap"},
-        {"help", "with-camera"});
+        {"help", "with-camera", "labels-only"});
     if (cli.has("help")) {
       std::cout << kUsage;
       return 0;
