@@ -461,4 +461,45 @@ TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
   fs::remove_all(out);
 }
 
+// --labels-only: the object's labels over the recorded images, which stay as they were (the
+// labelled run's baseline: the same view hidden, nothing moving).
+TEST(MakeDynamic, LabelsOnlyKeepsTheRecordedImages) {
+  const fs::path tum = freshFolder("tum_labels_only");
+  const Process made_tum =
+      execute(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
+              tum.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --labels-only");
+  ASSERT_EQ(made_tum.status, 0) << made_tum.output;
+  const cvo::TumSequence source(kTum.string()), made(tum.string());
+  ASSERT_EQ(made.frames().size(), source.frames().size());
+  for (const std::size_t k : {std::size_t{0}, source.frames().size() - 1}) {
+    SCOPED_TRACE("TUM frame " + std::to_string(k));
+    cv::Mat image, depth, made_image, made_depth;
+    source.load(k, &image, &depth);
+    made.load(k, &made_image, &made_depth);
+    EXPECT_EQ(cv::norm(image, made_image, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(depth, made_depth, cv::NORM_INF), 0.0);
+    const cv::Mat labels =
+        cv::imread((tum / "labels" / made.frames()[k].rgb_listed).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(labels.empty());
+    EXPECT_GT(cv::countNonZero(labels == 1), static_cast<int>(labels.total() / 10));
+  }
+  fs::remove_all(tum);
+
+  const fs::path kitti = freshFolder("kitti_labels_only");
+  const Process made_kitti = execute(
+      std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
+      kitti.string() + "' --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --labels-only");
+  ASSERT_EQ(made_kitti.status, 0) << made_kitti.output;
+  const cvo::KittiSequence kitti_source(kKitti.string());
+  const cvo::KittiSequence kitti_made(kitti.string(), 0, (kitti / "labels" / "image_0").string());
+  cv::Mat left, right, made_left, made_right, labels;
+  kitti_source.load(0, &left, &right, nullptr);
+  kitti_made.load(0, &made_left, &made_right, &labels);
+  EXPECT_EQ(cv::norm(left, made_left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(right, made_right, cv::NORM_INF), 0.0);
+  ASSERT_FALSE(labels.empty());
+  EXPECT_NEAR(cv::countNonZero(labels == 1) / static_cast<double>(labels.total()), 0.16, 0.03);
+  fs::remove_all(kitti);
+}
+
 }  // namespace
