@@ -54,6 +54,11 @@ bool claim(std::atomic<std::uint64_t>& range, bool from_front, std::size_t* bloc
 BlockPool::BlockPool(int threads) {
   for (int k = 1; k < threads; ++k)
     helpers_.emplace_back([this, k] { help(k); });
+  active_.store(this->threads());
+}
+
+void BlockPool::setActiveThreads(int threads) {
+  active_.store(std::clamp(threads, 1, this->threads()));
 }
 
 BlockPool::~BlockPool() {
@@ -81,7 +86,7 @@ void BlockPool::runBlock(Loop& loop, std::size_t b) {
 
 void BlockPool::work(Loop& loop, int self) {
   // self < loop.shares: a loop of one share is never published to the helpers, and a published
-  // one has a share for every thread. Once no range holds a block, `block` may be gone: it is
+  // one has a share for every active thread (help() leaves the others out). Once no range holds a block, `block` may be gone: it is
   // not touched again.
   std::size_t b = 0;
   while (claim(loop.ranges[self].range, true, &b))
@@ -108,7 +113,8 @@ void BlockPool::help(int self) {
       seen = generation_;
       loop = loop_;
     }
-    if (loop) work(*loop, self);
+    // A loop shared among fewer threads than the pool has leaves the others out.
+    if (loop && self < loop->shares) work(*loop, self);
   }
 }
 
@@ -137,8 +143,9 @@ void BlockPool::runLoop(std::size_t count, const std::function<void(std::size_t)
   auto loop = std::make_shared<Loop>();
   loop->count = count;
   loop->block = &block;
-  const bool shared = !helpers_.empty() && count > 1;
-  loop->shares = shared ? threads() : 1;
+  const int active = active_.load();
+  const bool shared = active > 1 && count > 1;
+  loop->shares = shared ? active : 1;
   loop->ranges = std::make_unique<Loop::Share[]>(static_cast<std::size_t>(loop->shares));
   const std::uint64_t n = count, shares = static_cast<std::uint64_t>(loop->shares);
   for (std::uint64_t k = 0; k < shares; ++k)

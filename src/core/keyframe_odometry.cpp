@@ -95,6 +95,11 @@ void KeyframeOdometry::setParams(const CvoParams& params) {
   reference_self_.reset();  // the kernels may have changed
 }
 
+void KeyframeOdometry::setThreadLimit(int threads) {
+  registration_.backend().setThreadLimit(threads);
+  photometric_pool_.setActiveThreads(threads);
+}
+
 void KeyframeOdometry::remapDepths(const std::function<float(float)>& new_depth) {
   const auto remapped = [&](const std::shared_ptr<const LabeledCloud>& cloud) {
     return std::make_shared<const LabeledCloud>(cloud->withDepths(new_depth));

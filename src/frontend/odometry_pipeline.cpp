@@ -1,6 +1,7 @@
 #include "cvo_odometry/frontend/odometry_pipeline.hpp"
 
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -48,6 +49,7 @@ OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFact
     : settings_(settings), factory_(std::move(factory)) {
   settings_.validate();
   odometry_ = makeOdometry(settings_);
+  resetGovernor();
   rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(settings_.rgbdOptions());
   stereo_builder_ = std::make_unique<StereoCloudBuilder>(settings_.stereoOptions());
   tracker_ = std::make_unique<FeatureTracker>(settings_.features);
@@ -64,6 +66,13 @@ std::unique_ptr<KeyframeOdometry> OdometryPipeline::makeOdometry(const OdometryS
   return odometry;
 }
 
+void OdometryPipeline::resetGovernor() {
+  governor_.reset();
+  const int threads = resolvedThreadCount(settings_.cvo.num_threads);
+  if (settings_.cvo.adaptive_threads && threads > 1) governor_.emplace(threads);
+  odometry_->setThreadLimit(threads);
+}
+
 bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   settings.validate();
   // Build everything new first: a refusal leaves the pipeline as it was.
@@ -72,6 +81,8 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   auto tracker = std::make_unique<FeatureTracker>(settings.features);
   const bool new_backend = settings.cvo.backend != settings_.cvo.backend ||
                            settings.cvo.num_threads != settings_.cvo.num_threads;
+  const bool new_governor =
+      new_backend || settings.cvo.adaptive_threads != settings_.cvo.adaptive_threads;
   // The offset's estimate belongs to the rig: it survives other changes, not new settings of
   // its own.
   const DisparityOffsetOptions& a = settings.disparity_offset_estimate;
@@ -93,6 +104,7 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   } else {
     odometry_->setParams(settings.cvo);
   }
+  if (new_governor) resetGovernor();
   if (offset_calibration) {
     // Back to the new start: the reference is moved there, as for an estimate's change (after
     // a new backend's reset there is nothing to move).
@@ -167,7 +179,10 @@ void OdometryPipeline::advancePriorPose(PipelineResult& result) {
 PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
                                          const Eigen::Isometry3d& base_from_camera) {
   const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   PipelineResult result;
+  result.threads = governor_ ? governor_->threads()
+                             : resolvedThreadCount(settings_.cvo.num_threads);
   const std::optional<double> last = odometry_->lastStamp();
   if (last && stamp == *last) {
     result.outcome = FrameOutcome::kSkipped;
@@ -257,6 +272,15 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     result.disparity_offset_ms = millisecondsSince(calibration_start);
   }
   result.total_ms = millisecondsSince(start);
+  if (governor_) {
+    // The process's CPU time: every thread's, ours and OpenCV's (another nodelet's in the same
+    // manager too, which only makes the fallback rarer).
+    const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+    const int before = governor_->threads();
+    if (governor_->update(result.total_ms, cpu_ms) != before) {
+      odometry_->setThreadLimit(governor_->threads());
+    }
+  }
   return result;
 }
 

@@ -52,6 +52,8 @@ void OdometryDiagnostics::count(const PipelineResult& result, double latency_ms)
     return;
   }
   ++frames_;
+  threads_ = result.threads;
+  if (result.threads == 1) ++one_thread_frames_;
   if (result.disparity_offset_estimate) disparity_offset_ = result.disparity_offset_estimate;
   const OdometryUpdate& update = result.update;
   switch (update.state) {
@@ -165,6 +167,8 @@ void OdometryDiagnostics::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("backend fallbacks", fallbacks_);
   status.add("resets", resets_);
   status.add("backend", backend_);
+  status.add("CPU threads (adaptive_threads: one while the frames get about a core)", threads_);
+  status.add("frames on one thread", one_thread_frames_);
   if (disparity_offset_) {
     // Stereo self-calibration (README "Stereo scale"): what the front end uses once trusted.
     status.add("disparity offset estimate (px)", disparity_offset_->offset);

@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
     // how many cores the run got. Under load it tells where the scheduler put the run (README
     // "Benchmark": about 1 with a core to itself, about 0.55 when sharing one with a busy loop).
     double cpu_ms_sum = 0.0, total_ms_sum = 0.0;
+    std::size_t processed = 0, one_thread = 0;  // adaptive_threads: frames it ran on one thread
     for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
@@ -125,6 +126,8 @@ int main(int argc, char** argv) {
       const cvo::OdometryUpdate& update = result.update;
       tally.add(result);
       if (result.outcome == cvo::FrameOutcome::kProcessed) {
+        ++processed;
+        if (result.threads == 1) ++one_thread;
         if (update.has_pose) trajectory.append(input.stamps[k], update.pose);
         if (update.has_pose && update.trusted()) trusted.push_back(input.stamps[k]);
         if (update.state == cvo::TrackingState::kReset) restarts.push_back(input.stamps[k]);
@@ -233,6 +236,14 @@ int main(int argc, char** argv) {
     if (total_ms_sum > 0.0) {
       std::cout << std::setprecision(2) << "cores in use: " << cpu_ms_sum / total_ms_sum
                 << " (the process's CPU time over the wall time of its frames' total)\n";
+    }
+    const int threads = cvo::resolvedThreadCount(settings.cvo.num_threads);
+    if (threads > 1) {
+      std::cout << "threads: " << threads << ", " << one_thread << " of " << processed
+                << " frames on one thread ("
+                << (settings.cvo.adaptive_threads ? "adaptive_threads: while the frames got no "
+                                                    "more than about a core)\n"
+                                                  : "adaptive_threads off)\n");
     }
     if (cli.has("out")) {
       const auto format = cli.has("format") ? cvo::parseTrajectoryFormat(cli.get("format"))

@@ -3,7 +3,9 @@
 // a pool survives many loops back to back (helpers waking late find no stale loop).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <numeric>
 #include <stdexcept>
 #include <thread>
@@ -23,6 +25,40 @@ TEST(BlockPool, EveryBlockRunsExactlyOnceOnAnyThreadCount) {
       pool.run(count, [&](std::size_t b) { ++runs[b]; });
       for (std::size_t b = 0; b < count; ++b)
         ASSERT_EQ(runs[b].load(), 1) << threads << " threads, block " << b << " of " << count;
+    }
+  }
+}
+
+// A pool limited to fewer threads than it has: every block once, on no more distinct threads
+// than the limit (one: the caller alone), and all threads again when the limit is lifted.
+TEST(BlockPool, ActiveThreadsLimitWhoRunsTheBlocks) {
+  BlockPool pool(3);
+  EXPECT_EQ(pool.activeThreads(), 3);
+  pool.setActiveThreads(0);
+  EXPECT_EQ(pool.activeThreads(), 1);
+  pool.setActiveThreads(7);
+  EXPECT_EQ(pool.activeThreads(), 3);
+  for (int active : {1, 2, 3}) {
+    pool.setActiveThreads(active);
+    for (int loop = 0; loop < 50; ++loop) {
+      constexpr std::size_t kCount = 64;
+      std::vector<std::atomic<int>> runs(kCount);
+      std::vector<std::thread::id> ran_on(kCount);
+      pool.run(kCount, [&](std::size_t b) {
+        ++runs[b];
+        ran_on[b] = std::this_thread::get_id();
+        // Long enough for the helpers to wake and claim their shares.
+        std::this_thread::sleep_for(std::chrono::microseconds(20));
+      });
+      std::vector<std::thread::id> threads(ran_on);
+      std::sort(threads.begin(), threads.end());
+      threads.erase(std::unique(threads.begin(), threads.end()), threads.end());
+      for (std::size_t b = 0; b < kCount; ++b)
+        ASSERT_EQ(runs[b].load(), 1) << active << " active, block " << b;
+      ASSERT_LE(static_cast<int>(threads.size()), active);
+      if (active == 1) {
+        ASSERT_EQ(threads.front(), std::this_thread::get_id());
+      }
     }
   }
 }

@@ -34,6 +34,12 @@ class BlockPool {
 
   int threads() const { return static_cast<int>(helpers_.size()) + 1; }
 
+  // Loops from the next one on share their blocks among at most `threads` of the pool's threads
+  // (the caller counts; clamped to [1, threads()]): fewer while the helpers get no core of their
+  // own (ThreadGovernor). The results do not change.
+  void setActiveThreads(int threads);
+  int activeThreads() const { return active_.load(); }
+
   // Calls block(b) once for every b in [0, count) and returns when all have returned; the
   // first exception a block throws is rethrown here, after the others finished. One loop at a
   // time per pool (callers serialize).
@@ -58,6 +64,7 @@ class BlockPool {
   std::atomic<std::size_t> started_{0};  // generation_, read without the lock
   bool stop_ = false;
   std::vector<std::thread> helpers_;
+  std::atomic<int> active_{1};  // threads a loop shares its blocks among
 };
 
 // Calls block(b) for every b in [0, count) on `pool`, or on this thread alone, in order, when

@@ -28,6 +28,7 @@ class CpuBackend : public RegistrationBackend {
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
+  void setThreadLimit(int threads) override { pool_.setActiveThreads(threads); }
 
  private:
   // Candidate pairs of one block of source points, CSR layout. With geometry only every pair's

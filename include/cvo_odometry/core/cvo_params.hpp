@@ -120,6 +120,9 @@ struct CvoParams {
 
   BackendChoice backend = BackendChoice::kAuto;
   int num_threads = 0;
+  // With more than one thread: one while the process gets no more than about a core (cores
+  // shared with other processes), all again when they free up (ThreadGovernor).
+  bool adaptive_threads = true;
 
   // Tracking quality, judged per frame (tracking_check.hpp): a registration is good when it
   // converged, its cosine is >= min_cosine, both clouds have >= min_tracking_points and its

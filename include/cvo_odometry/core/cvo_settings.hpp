@@ -117,6 +117,10 @@ void visitSettings(CvoParams& p, V&& v) {
   // Where the sums run
   v(SettingInfo{"backend", "backend", "auto: the GPU when one is usable, else the CPU"}, p.backend);
   v(SettingInfo{"num_threads", "backend", "CPU threads (0: all cores)", 0, 1024}, p.num_threads);
+  v(SettingInfo{"adaptive_threads", "backend",
+                "one thread while the frames get no more than about one core (a CPU shared with "
+                "other processes), all again when more is free"},
+    p.adaptive_threads);
   // Tracking judgement
   v(SettingInfo{"min_cosine", "tracking", "a registration below this cosine is not trusted", 0.0,
                 0.99},

@@ -22,6 +22,10 @@ class FailoverBackend : public RegistrationBackend {
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
+  void setThreadLimit(int threads) override {
+    primary_->setThreadLimit(threads);
+    secondary_->setThreadLimit(threads);
+  }
 
   void restore() { failed_ = false; }
   bool failedOver() const { return failed_; }

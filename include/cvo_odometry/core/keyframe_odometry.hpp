@@ -124,6 +124,9 @@ class KeyframeOdometry {
   // been, each point along its ray to depth new_depth(z) (LabeledCloud::withDepths), so the next
   // frame is registered to a reference built as it is.
   void remapDepths(const std::function<float(float)>& new_depth);
+  // At most `threads` CPU threads for the registration and the photometric stage from the next
+  // frame on (ThreadGovernor; clamped to [1, num_threads]); the results do not change.
+  void setThreadLimit(int threads);
 
   CvoRegistration& registration() { return registration_; }
   const CvoParams& params() const { return registration_.params(); }

@@ -37,6 +37,9 @@ class RegistrationBackend {
   // Gradient and Hessian of sum (a - sp_thres)_+ at exp(xi) T, xi = 0, over the pairs retained
   // at T (the Newton step at the finest lengthscale).
   virtual kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) = 0;
+  // From the next call on, use at most `threads` CPU threads (>= 1; ThreadGovernor). Backends
+  // without CPU threads of their own ignore it; results do not depend on it.
+  virtual void setThreadLimit(int /*threads*/) {}
 };
 
 // Squared cut-off of the scaled joint distance D^2 = |x - z|^2 / ell^2 + sum_V |u - v|^2 / ell_V^2:

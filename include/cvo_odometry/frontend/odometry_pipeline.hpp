@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 
 #include "cvo_odometry/core/keyframe_odometry.hpp"
+#include "cvo_odometry/core/thread_governor.hpp"
 #include "cvo_odometry/frontend/disparity_offset_calibration.hpp"
 #include "cvo_odometry/frontend/feature_tracker.hpp"
 #include "cvo_odometry/frontend/odometry_settings.hpp"
@@ -54,6 +55,9 @@ struct PipelineResult {
   std::optional<DisparityOffsetEstimate> disparity_offset_estimate;
   double disparity_offset_ms = 0.0;  // the estimate's update, on the caller's thread
   double total_ms = 0.0;
+  // The CPU threads the registration and the photometric stage ran with (adaptive_threads: one
+  // while the process got no more than about a core).
+  int threads = 1;
 };
 
 class OdometryPipeline {
@@ -83,6 +87,8 @@ class OdometryPipeline {
 
  private:
   std::unique_ptr<KeyframeOdometry> makeOdometry(const OdometrySettings& settings);
+  // A new governor for settings_ (none with adaptive_threads off or one thread), all threads.
+  void resetGovernor();
   static std::unique_ptr<DisparityOffsetCalibration> makeOffsetCalibration(
       const OdometrySettings& settings);
   // The stereo depths are built at disparity offset `to` instead of `from` from now on (a rig
@@ -101,6 +107,7 @@ class OdometryPipeline {
   BackendFactory factory_;
   std::string backend_note_;
   std::unique_ptr<KeyframeOdometry> odometry_;
+  std::optional<ThreadGovernor> governor_;  // adaptive_threads
   std::unique_ptr<RgbdCloudBuilder> rgbd_builder_;
   std::unique_ptr<StereoCloudBuilder> stereo_builder_;
   std::unique_ptr<FeatureTracker> tracker_;
