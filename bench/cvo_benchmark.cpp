@@ -5,10 +5,13 @@
 // 2 ms per registration at 15k points with colour (procrustes) on an H100/H200-class GPU, and at
 // least 10x the CPU backend on the same machine. Needs only the core (no ROS/OpenCV).
 // --time-calls adds a line per row: the backend's calls per registration and their time, and the
-// rest of the registration (its own steps between calls).
+// rest of the registration (its own steps between calls); for the device backends also the
+// device work a registration asks for (Thrust algorithms, uploads, host waits: the same on
+// device_cpu as on the GPU).
 #include <algorithm>
 #include <cstdio>
 #include <iomanip>
+#include <optional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -37,7 +40,8 @@ const char* kUsage =
     "                        so that a row's size is what it sums over)\n"
     "  --reference-max-size N  skip the reference method above this size (3000)\n"
     "  --time-calls          after each row, the backend's calls per registration, their ms,\n"
-    "                        and the rest of the registration's ms\n"
+    "                        and the rest of the registration's ms; device backends: the\n"
+    "                        Thrust algorithms, uploads and host waits a registration asks for\n"
     "  --check-cuda          only say whether a CUDA device is usable (exit 0, else 3)\n";
 
 // The GPU target (README "Benchmark"): 15k points, colour, the default method.
@@ -71,6 +75,19 @@ void printCallTimes(const cvo::TimedBackend& timed, int registrations, double to
   }
   std::cout << " rest " << std::setprecision(3) << (total_ms - timed.totalMs()) / registrations
             << " ms\n";
+}
+
+// "#   device work per registration: ..." from the counts before and after the timed runs.
+void printDeviceWork(const cvo::DeviceWork& before, const cvo::DeviceWork& after,
+                     int registrations) {
+  const auto per = [&](long a, long b) { return static_cast<double>(b - a) / registrations; };
+  std::cout << std::setprecision(1) << "#   device work per registration: "
+            << per(before.algorithms, after.algorithms) << " Thrust algorithms ("
+            << per(before.evaluations, after.evaluations) << " evaluations, one reduction and "
+            << "one wait each; " << per(before.grid_builds, after.grid_builds) << " grid builds), "
+            << per(before.uploads, after.uploads) << " uploads, "
+            << per(before.evaluations + before.uploads, after.evaluations + after.uploads)
+            << " host waits\n";
 }
 
 }  // namespace
@@ -142,6 +159,8 @@ int main(int argc, char** argv) {
             cvo::RegistrationReport report;
             registration.align(target, source, Eigen::Isometry3d::Identity());  // warm-up
             if (timed) timed->reset();
+            const std::optional<cvo::DeviceWork> work_before =
+                timed ? timed->deviceWork() : std::nullopt;
             for (int r = 0; r < repeat; ++r) {
               report = registration.align(target, source, Eigen::Isometry3d::Identity()).report;
               ms.push_back(report.time_ms);
@@ -160,6 +179,7 @@ int main(int argc, char** argv) {
               for (const double m : ms)
                 total_ms += m;
               printCallTimes(*timed, repeat, total_ms);
+              if (work_before) printDeviceWork(*work_before, *timed->deviceWork(), repeat);
             }
             if (size == "15000" && method == "procrustes" && kernels == "color") {
               if (backend == "cpu") target_cpu_ms = median_ms;

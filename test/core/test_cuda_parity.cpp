@@ -17,6 +17,7 @@
 #include "cvo_odometry/core/backend_factory.hpp"
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
+#include "cvo_odometry/core/timed_backend.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/device_backend.hpp"
 #include "cvo_odometry/core/failover_backend.hpp"
@@ -393,6 +394,36 @@ TEST_P(DeviceTest, SumsMatchTheCpu) {
       }
     }
   }
+}
+
+// The device work counted per call matches the calls a registration makes (cvo_benchmark
+// --time-calls prints it per registration): one reduction and one wait per evaluation, one upload
+// per cloud a problem sets, and each grid build's algorithms.
+TEST_P(DeviceTest, DeviceWorkCountsTheRegistrationsCalls) {
+  const LabeledCloud target = cvo::readCloud(tumFile("frame10_3000"));
+  const LabeledCloud source = cvo::readCloud(tumFile("frame11_3000"));
+  cvo::CvoParams params;
+  params.use_color = true;
+  auto timed_backend = std::make_unique<cvo::TimedBackend>(device());
+  const cvo::TimedBackend& timed = *timed_backend;
+  ASSERT_TRUE(timed.deviceWork());
+  const cvo::DeviceWork before = *timed.deviceWork();
+  EXPECT_EQ(before.algorithms, 0);
+  cvo::CvoRegistration registration(params, std::move(timed_backend));
+  const auto result = registration.align(target, source, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(result.report.converged);
+  const cvo::DeviceWork work = *timed.deviceWork();
+  using Call = cvo::TimedBackend::Call;
+  const long evaluations = timed.tally(Call::kMoments).calls +
+                           timed.tally(Call::kOneOffMoments).calls +
+                           timed.tally(Call::kTaylor).calls + timed.tally(Call::kCurvature).calls;
+  EXPECT_GT(evaluations, 0);
+  EXPECT_EQ(work.evaluations, evaluations);
+  EXPECT_EQ(work.uploads, 2 * timed.tally(Call::kSetProblem).calls);
+  EXPECT_GE(work.grid_builds, 1);
+  EXPECT_LE(work.grid_builds, evaluations);
+  // A grid build: cells, sequence, sort, cell starts and a gather per array (positions, colours).
+  EXPECT_EQ(work.algorithms, work.evaluations + 6 * work.grid_builds);
 }
 
 TEST_P(DeviceTest, EmptyAndSinglePointClouds) {

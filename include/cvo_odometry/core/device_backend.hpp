@@ -22,6 +22,7 @@ class DeviceBackend : public RegistrationBackend {
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
+  std::optional<DeviceWork> deviceWork() const override { return device_.work(); }
 
  private:
   DevicePairSums<System> device_;

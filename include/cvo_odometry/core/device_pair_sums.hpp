@@ -17,6 +17,18 @@ namespace cvo {
 
 enum class DeviceSystem { kCuda, kOmp };
 
+// What the device code has been asked to do so far, the same count on both systems (the fixed
+// costs a registration pays per call, measured where no GPU is: cvo_benchmark --time-calls on
+// device_cpu). Thrust algorithms: on CUDA each is one or more kernel launches (a reduction two
+// and a copy back, the grid's stable sort several). The host waits once per evaluation (for its
+// sums) and once per upload.
+struct DeviceWork {
+  long algorithms = 0;   // Thrust algorithms run, grid builds' and evaluations' together
+  long grid_builds = 0;  // the target's neighbour grid (4 algorithms and a gather per array)
+  long evaluations = 0;  // moments, Taylor or curvature sums: one reduction each
+  long uploads = 0;      // clouds copied to the device
+};
+
 template <DeviceSystem System>
 class DevicePairSums {
  public:
@@ -35,6 +47,8 @@ class DevicePairSums {
   kernels::MomentSums moments(const float* pose, double ell);
   kernels::TaylorSums taylor(const float* pose, const double* xi, double ell);
   kernels::CurvatureSums curvature(const float* pose, double ell);
+
+  const DeviceWork& work() const;
 
  private:
   struct Impl;

@@ -26,6 +26,7 @@ class FailoverBackend : public RegistrationBackend {
     primary_->setThreadLimit(threads);
     secondary_->setThreadLimit(threads);
   }
+  std::optional<DeviceWork> deviceWork() const override { return primary_->deviceWork(); }
 
   void restore() { failed_ = false; }
   bool failedOver() const { return failed_; }

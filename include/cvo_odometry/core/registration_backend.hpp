@@ -8,7 +8,10 @@
 
 #include <Eigen/Geometry>
 
+#include <optional>
+
 #include "cvo_odometry/core/cvo_params.hpp"
+#include "cvo_odometry/core/device_pair_sums.hpp"
 #include "cvo_odometry/core/labeled_cloud.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/pair_kernels.hpp"
@@ -40,6 +43,8 @@ class RegistrationBackend {
   // From the next call on, use at most `threads` CPU threads (>= 1; ThreadGovernor). Backends
   // without CPU threads of their own ignore it; results do not depend on it.
   virtual void setThreadLimit(int /*threads*/) {}
+  // The device code's work so far (cuda, device_cpu); none for the CPU backend.
+  virtual std::optional<DeviceWork> deviceWork() const { return std::nullopt; }
 };
 
 // Squared cut-off of the scaled joint distance D^2 = |x - z|^2 / ell^2 + sum_V |u - v|^2 / ell_V^2:

@@ -31,6 +31,7 @@ class TimedBackend : public RegistrationBackend {
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;
   void setThreadLimit(int threads) override { inner_->setThreadLimit(threads); }
+  std::optional<DeviceWork> deviceWork() const override { return inner_->deviceWork(); }
 
   const Tally& tally(Call call) const { return tallies_[call]; }
   static const char* callName(Call call);

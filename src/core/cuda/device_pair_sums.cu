@@ -261,6 +261,13 @@ struct DevicePairSums<System>::Impl {
   double cutoff2 = 0.0;
   double grid_radius = -1.0;  // the query radius the grid was built for; -1: none
   kernels::DenseGridShape shape{};
+  DeviceWork work;
+
+  // The policy of one Thrust algorithm, counted.
+  decltype(auto) policy() {
+    ++work.algorithms;
+    return runtime.policy();
+  }
 
   // The target sorted by grid cell (a stable sort of the cell indices) and each cell's first
   // point (binary searches of every cell index in the sorted cells), all on the device.
@@ -279,15 +286,15 @@ struct DevicePairSums<System>::Impl {
     grow(cell, n);
     grow(order, n);
     grow(start, total + 1);
-    auto policy = runtime.policy();
+    ++work.grid_builds;
     const thrust::counting_iterator<int> points(0);
-    thrust::transform(policy, points, points + n, cell.begin(),
+    thrust::transform(policy(), points, points + n, cell.begin(),
                       CellOfPoint{rawPointer(uploaded[0][0]), shape});
-    thrust::sequence(policy, order.begin(), order.begin() + n);
-    thrust::stable_sort_by_key(policy, cell.begin(), cell.begin() + n, order.begin());
+    thrust::sequence(policy(), order.begin(), order.begin() + n);
+    thrust::stable_sort_by_key(policy(), cell.begin(), cell.begin() + n, order.begin());
     // start[c] = the first sorted point of cell c; start[total] = n.
     const thrust::counting_iterator<unsigned> cell_index(0);
-    thrust::lower_bound(policy, cell.begin(), cell.begin() + n, cell_index,
+    thrust::lower_bound(policy(), cell.begin(), cell.begin() + n, cell_index,
                         cell_index + (total + 1), start.begin());
     const int widths[3] = {3, target_has_color ? kernels::kColorDim : 0, classes};
     for (int a = 0; a < 3; ++a) {
@@ -297,7 +304,7 @@ struct DevicePairSums<System>::Impl {
       const auto element = thrust::make_transform_iterator(
           thrust::counting_iterator<unsigned>(0),
           SortedElement{rawPointer(order), static_cast<unsigned>(widths[a])});
-      thrust::gather(policy, element, element + size, uploaded[0][a].begin(), sorted[a].begin());
+      thrust::gather(policy(), element, element + size, uploaded[0][a].begin(), sorted[a].begin());
     }
     grid_radius = radius;
   }
@@ -330,7 +337,8 @@ struct DevicePairSums<System>::Impl {
     kernels::clear(zero);
     const thrust::counting_iterator<int> points(0);
     const int items = count[1] * kLanesPerPoint;
-    return thrust::transform_reduce(runtime.policy(), points, points + items,
+    ++work.evaluations;
+    return thrust::transform_reduce(policy(), points, points + items,
                                     ShareOfPoint<Sums, Add>{context(pose, ell), add}, zero,
                                     AddSums<Sums>{});
   }
@@ -360,6 +368,7 @@ void DevicePairSums<System>::setCloud(bool target, const float* positions, const
       destination[a] = rawPointer(d.uploaded[which][a]);
     }
     d.runtime.upload(3, host, sizes, destination);
+    ++d.work.uploads;
     d.count[which] = count;
     d.classes = classes;
     if (target) {
@@ -400,6 +409,11 @@ kernels::CurvatureSums DevicePairSums<System>::curvature(const float* pose, doub
   return guarded("curvature", [&] {
     return impl_->template sumOverSource<kernels::CurvatureSums>(pose, ell, AddCurvature{});
   });
+}
+
+template <DeviceSystem System>
+const DeviceWork& DevicePairSums<System>::work() const {
+  return impl_->work;
 }
 
 template class DevicePairSums<device::kSystem>;
