@@ -11,9 +11,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <iomanip>
-#include <optional>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -81,9 +81,10 @@ void printCallTimes(const cvo::TimedBackend& timed, int registrations, double to
 void printDeviceWork(const cvo::DeviceWork& before, const cvo::DeviceWork& after,
                      int registrations) {
   const auto per = [&](long a, long b) { return static_cast<double>(b - a) / registrations; };
-  std::cout << std::setprecision(1) << "#   device work per registration: "
-            << per(before.algorithms, after.algorithms) << " Thrust algorithms ("
-            << per(before.evaluations, after.evaluations) << " evaluations, one reduction and "
+  std::cout << std::setprecision(1)
+            << "#   device work per registration: " << per(before.algorithms, after.algorithms)
+            << " Thrust algorithms (" << per(before.evaluations, after.evaluations)
+            << " evaluations, one reduction and "
             << "one wait each; " << per(before.grid_builds, after.grid_builds) << " grid builds), "
             << per(before.uploads, after.uploads) << " uploads, "
             << per(before.evaluations + before.uploads, after.evaluations + after.uploads)

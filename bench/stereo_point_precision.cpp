@@ -34,7 +34,8 @@
 namespace {
 
 const char* kUsage =
-    "usage: stereo_point_precision --kitti DIR [--stride N] [--matchers dense,quarter,half,sparse]\n"
+    "usage: stereo_point_precision --kitti DIR [--stride N] [--matchers "
+    "dense,quarter,half,sparse]\n"
     "       [--crop 100] [--corners 1000] [--block 5] [--refine 15] [--refine-height 5]\n"
     "       [--cap 63] [--radius 3] [--uniqueness 5] [--lr 1]\n"
     "  DIR: a KITTI odometry folder with poses.txt. --block ... --lr: the point matcher's\n"
@@ -72,7 +73,8 @@ class DenseMatcher : public Matcher {
   }
   std::vector<float> at(const std::vector<cv::Point>& pixels) override {
     std::vector<float> out;
-    for (const cv::Point& p : pixels) out.push_back(disparity_.at<float>(p));
+    for (const cv::Point& p : pixels)
+      out.push_back(disparity_.at<float>(p));
     return out;
   }
 
@@ -99,9 +101,10 @@ class PointMatcher : public Matcher {
 
 int main(int argc, char** argv) {
   try {
-    const cvo::CommandLine cli(
-        argc, argv, {"kitti", "stride", "matchers", "crop", "corners", "block", "refine", "refine-height", "cap", "radius", "uniqueness", "lr"},
-        {"help"});
+    const cvo::CommandLine cli(argc, argv,
+                               {"kitti", "stride", "matchers", "crop", "corners", "block", "refine",
+                                "refine-height", "cap", "radius", "uniqueness", "lr"},
+                               {"help"});
     if (cli.has("help")) {
       std::cout << kUsage;
       return 0;
@@ -112,10 +115,13 @@ int main(int argc, char** argv) {
     const int stride = cli.getInt("stride", 1);
     const int crop = cli.getInt("crop", 100);
     const int max_corners = cli.getInt("corners", 1000);
-    if (stride < 1 || crop < 0 || max_corners < 1) throw std::invalid_argument("bad option");
+    if (stride < 1 || crop < 0 || max_corners < 1) {
+      throw std::invalid_argument("--stride and --corners must be >= 1 and --crop >= 0");
+    }
     std::vector<std::string> names;
     std::stringstream list(cli.get("matchers", "dense,quarter,half,sparse"));
-    for (std::string name; std::getline(list, name, ',');) names.push_back(name);
+    for (std::string name; std::getline(list, name, ',');)
+      names.push_back(name);
     std::vector<std::unique_ptr<Matcher>> matchers;
     for (const std::string& name : names) {
       if (name == "dense") {
@@ -152,7 +158,8 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k + stride < frames; ++k) {
       sequence.load(k, &left, &right, &unused);
       sequence.load(k + stride, &next_left, &next_right, &unused);
-      for (cv::Mat* image : {&left, &right, &next_left, &next_right}) *image = cvo::toGrey(*image);
+      for (cv::Mat* image : {&left, &right, &next_left, &next_right})
+        *image = cvo::toGrey(*image);
       cv::Mat mask = cv::Mat::zeros(left.size(), CV_8UC1);
       mask.rowRange(crop, left.rows).setTo(255);
       std::vector<cv::Point2f> corners, tracked, back;
@@ -161,8 +168,7 @@ int main(int argc, char** argv) {
       std::vector<unsigned char> ok, ok_back;
       std::vector<float> error;
       cv::calcOpticalFlowPyrLK(left, next_left, corners, tracked, ok, error, cv::Size(21, 21), 3);
-      cv::calcOpticalFlowPyrLK(next_left, left, tracked, back, ok_back, error, cv::Size(21, 21),
-                               3);
+      cv::calcOpticalFlowPyrLK(next_left, left, tracked, back, ok_back, error, cv::Size(21, 21), 3);
       const Eigen::Isometry3d motion = truth[k].pose.inverse() * truth[k + stride].pose;
       std::vector<cv::Point> at_before, at_after;
       std::vector<Track> kept;
@@ -210,10 +216,12 @@ int main(int argc, char** argv) {
         common[i] = common[i] && has;
       }
     }
-    const auto common_count = static_cast<std::size_t>(std::count(common.begin(), common.end(), true));
+    const auto common_count =
+        static_cast<std::size_t>(std::count(common.begin(), common.end(), true));
     std::cout << "KITTI " << folder << ", stride " << stride << ": " << pairs << " pairs, " << n
               << " tracks, " << common_count << " with a disparity from every matcher\n"
-              << "| matcher | coverage | median residual at c = 0 px | offset c px | median abs residual px "
+              << "| matcher | coverage | median residual at c = 0 px | offset c px | median abs "
+                 "residual px "
                  "| rms within 2 px | > 0.5 px | > 1 px |\n|---|---|---|---|---|---|---|---|\n";
     for (std::size_t j = 0; j < m; ++j) {
       double best_c = 0.0, best_median = INFINITY;

@@ -86,8 +86,8 @@ void BlockPool::runBlock(Loop& loop, std::size_t b) {
 
 void BlockPool::work(Loop& loop, int self) {
   // self < loop.shares: a loop of one share is never published to the helpers, and a published
-  // one has a share for every active thread (help() leaves the others out). Once no range holds a block, `block` may be gone: it is
-  // not touched again.
+  // one has a share for every active thread (help() leaves the others out). Once no range holds a
+  // block, `block` may be gone: it is not touched again.
   std::size_t b = 0;
   while (claim(loop.ranges[self].range, true, &b))
     runBlock(loop, b);

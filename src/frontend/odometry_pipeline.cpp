@@ -1,8 +1,8 @@
 #include "cvo_odometry/frontend/odometry_pipeline.hpp"
 
 #include <chrono>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <sstream>
@@ -181,8 +181,8 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   const auto start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   PipelineResult result;
-  result.threads = governor_ ? governor_->threads()
-                             : resolvedThreadCount(settings_.cvo.num_threads);
+  result.threads =
+      governor_ ? governor_->threads() : resolvedThreadCount(settings_.cvo.num_threads);
   const std::optional<double> last = odometry_->lastStamp();
   if (last && stamp == *last) {
     result.outcome = FrameOutcome::kSkipped;

@@ -50,8 +50,8 @@ void prefilter(const cv::Mat& grey, int row0, int cap, int pad, cv::Mat* out) {
 // costs[i] = sum over the window's pixels (rows a[r], b[r] for r < rows, columns -h..h) of
 // |a[r][c] - b[r][c + i]|, for i in [0, n) (n a multiple of kLanes): a's pixel against
 // consecutive pixels of b.
-void windowCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int h, int rows,
-                 int n, std::uint16_t* costs) {
+void windowCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int h, int rows, int n,
+                 std::uint16_t* costs) {
   for (int k = 0; k < n; k += kLanes) {
 #if CV_SIMD128
     cv::v_uint16x8 low = cv::v_setzero_u16(), high = cv::v_setzero_u16();
@@ -85,7 +85,8 @@ void windowCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int
 int rowSad(const std::uint8_t* const* a, const std::uint8_t* const* b, int rows, int width) {
 #if CV_SIMD128
   std::uint8_t keep[kLanes];
-  for (int i = 0; i < kLanes; ++i) keep[i] = i < width ? 0xff : 0;
+  for (int i = 0; i < kLanes; ++i)
+    keep[i] = i < width ? 0xff : 0;
   const cv::v_uint8x16 mask = cv::v_load(keep);
   unsigned sum = 0;
   for (int r = 0; r < rows; ++r)
@@ -94,7 +95,8 @@ int rowSad(const std::uint8_t* const* a, const std::uint8_t* const* b, int rows,
 #else
   int sum = 0;
   for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < width; ++c) sum += std::abs(a[r][c] - b[r][c]);
+    for (int c = 0; c < width; ++c)
+      sum += std::abs(a[r][c] - b[r][c]);
   return sum;
 #endif
 }
@@ -108,11 +110,11 @@ void PointMatcherOptions::validate() const {
   sgbm.block_size = block_size;
   sgbm.validate();  // the same rules as the dense matcher's
   if (refine_width != 0 && (refine_width < 3 || refine_width % 2 == 0 || refine_width > 15)) {
-    throw std::invalid_argument("refine_width must be 0 (the search window) or odd in [3, 15], got " +
-                                std::to_string(refine_width));
+    throw std::invalid_argument(
+        "refine_width must be 0 (the search window) or odd in [3, 15], got " +
+        std::to_string(refine_width));
   }
-  if (refine_width != 0 &&
-      (refine_height < 1 || refine_height % 2 == 0 || refine_height > 21)) {
+  if (refine_width != 0 && (refine_height < 1 || refine_height % 2 == 0 || refine_height > 21)) {
     throw std::invalid_argument("refine_height must be odd and in [1, 21], got " +
                                 std::to_string(refine_height));
   }
@@ -150,10 +152,9 @@ PointStereoMatcher::PointStereoMatcher(const PointMatcherOptions& options) : opt
         std::ceil((options_.min_disparity + options_.num_disparities) / double(scale)));
     const int block = options_.coarse_level == 1 ? 5 : 3;
     const int area = block * block;
-    coarse_sgbm_ = cv::StereoSGBM::create(low, std::max(16, roundUp(high - low, 16)), block,
-                                          8 * area, 32 * area, 1, 63, 10,
-                                          std::max(100 >> (2 * options_.coarse_level), 4), 2,
-                                          cv::StereoSGBM::MODE_SGBM_3WAY);
+    coarse_sgbm_ = cv::StereoSGBM::create(
+        low, std::max(16, roundUp(high - low, 16)), block, 8 * area, 32 * area, 1, 63, 10,
+        std::max(100 >> (2 * options_.coarse_level), 4), 2, cv::StereoSGBM::MODE_SGBM_3WAY);
   }
 }
 
@@ -200,20 +201,23 @@ void PointStereoMatcher::prepare(const cv::Mat& left, const cv::Mat& right, int 
     prefilter(grey_right, row0_, options_.prefilter_cap, pad_, &right_);
   };
   std::exception_ptr failure;
-  cv::parallel_for_(cv::Range(0, beside ? 3 : 2), [&](const cv::Range& parts) {
-    for (int part = parts.start; part < parts.end; ++part) {
-      try {
-        if (part == 0) coarse();
-        if (part == 1) derivatives();
-        if (part == 2) beside();
-      } catch (...) {
-        // Kept for the caller's thread (OpenCV would wrap it); the first one wins.
-        static std::mutex mutex;
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  }, beside ? 3 : 2);
+  cv::parallel_for_(
+      cv::Range(0, beside ? 3 : 2),
+      [&](const cv::Range& parts) {
+        for (int part = parts.start; part < parts.end; ++part) {
+          try {
+            if (part == 0) coarse();
+            if (part == 1) derivatives();
+            if (part == 2) beside();
+          } catch (...) {
+            // Kept for the caller's thread (OpenCV would wrap it); the first one wins.
+            static std::mutex mutex;
+            std::lock_guard<std::mutex> lock(mutex);
+            if (!failure) failure = std::current_exception();
+          }
+        }
+      },
+      beside ? 3 : 2);
   if (failure) {
     left_.release();
     right_.release();
@@ -293,15 +297,15 @@ std::vector<float> PointStereoMatcher::match(const std::vector<cv::Point>& pixel
   if (n < 256) {
     body(cv::Range(0, n));
   } else {
-    cv::parallel_for_(cv::Range(0, n), body, std::max(1, std::min(n / 256, 4 * cv::getNumThreads())));
+    cv::parallel_for_(cv::Range(0, n), body,
+                      std::max(1, std::min(n / 256, 4 * cv::getNumThreads())));
   }
   return out;
 }
 
 float PointStereoMatcher::matchOne(int x, int y, std::vector<std::uint16_t>& costs) const {
   const int h = options_.block_size / 2;
-  if (y < first_row_ || y - h < 0 || y + h >= size_.height || x - h < 0 ||
-      x + h >= size_.width) {
+  if (y < first_row_ || y - h < 0 || y + h >= size_.height || x - h < 0 || x + h >= size_.width) {
     return kNaN;
   }
   int lo = 0, hi = 0;
@@ -356,8 +360,8 @@ float PointStereoMatcher::matchOne(int x, int y, std::vector<std::uint16_t>& cos
   return refine(x, y, best, lo, hi, cost, top);
 }
 
-float PointStereoMatcher::refine(int x, int y, int best, int lo, int hi,
-                                 const std::uint16_t* costs, int top) const {
+float PointStereoMatcher::refine(int x, int y, int best, int lo, int hi, const std::uint16_t* costs,
+                                 int top) const {
   const auto parabola = [](double minus, double centre, double plus, int at) {
     const double curvature = minus + plus - 2.0 * centre;
     const double offset = curvature > 0.0 ? (minus - plus) / (2.0 * curvature) : 0.0;

@@ -115,7 +115,8 @@ void StereoCloudBuilder::completeDepth(const PointStereoMatcher& matcher, double
   }
 }
 
-cv::Mat StereoCloudBuilder::pointDepth(const StereoFrame& frame, PointStereoMatcher& matcher) const {
+cv::Mat StereoCloudBuilder::pointDepth(const StereoFrame& frame,
+                                       PointStereoMatcher& matcher) const {
   if (frame.left.size() != frame.right.size()) {
     throw std::invalid_argument("left image is " + std::to_string(frame.left.cols) + "x" +
                                 std::to_string(frame.left.rows) + " but right is " +
@@ -124,8 +125,8 @@ cv::Mat StereoCloudBuilder::pointDepth(const StereoFrame& frame, PointStereoMatc
   }
   options_.matcher.checkImageSize(frame.left.cols, frame.left.rows);
   const cv::Mat grey = toGrey(frame.left);
-  const int first = std::max(0, std::min(options_.cloud.crop_top_rows, grey.rows - 1) -
-                                    kMatchingContextRows);
+  const int first =
+      std::max(0, std::min(options_.cloud.crop_top_rows, grey.rows - 1) - kMatchingContextRows);
   std::vector<cv::Point> pixels;
   matcher.prepare(grey, toGrey(frame.right), first, [&] { pixels = pointPixels(grey); });
   cv::Mat depth = depthBuffer(grey.size());
@@ -189,8 +190,7 @@ cv::Mat StereoCloudBuilder::depth(const StereoFrame& frame) const {
                            options_.disparity_offset);
 }
 
-void StereoCloudBuilder::completeTrackDepth(const MotionPrior& prior,
-                                            const PinholeIntrinsics& K) {
+void StereoCloudBuilder::completeTrackDepth(const MotionPrior& prior, const PinholeIntrinsics& K) {
   if (!current_.matcher || current_.depth.empty()) return;
   std::vector<cv::Point> now, before;
   const auto around = [](double u, double v, std::vector<cv::Point>* out) {

@@ -17,11 +17,11 @@
 #include "cvo_odometry/core/backend_factory.hpp"
 #include "cvo_odometry/core/cloud_io.hpp"
 #include "cvo_odometry/core/cpu_backend.hpp"
-#include "cvo_odometry/core/timed_backend.hpp"
 #include "cvo_odometry/core/cvo_registration.hpp"
 #include "cvo_odometry/core/device_backend.hpp"
 #include "cvo_odometry/core/failover_backend.hpp"
 #include "cvo_odometry/core/fault_injection_backend.hpp"
+#include "cvo_odometry/core/timed_backend.hpp"
 #include "synthetic_scene.hpp"
 
 namespace {

@@ -47,8 +47,8 @@ struct RegistrationError {
   double rotation_deg = 0.0;
   double step_m = 0.0;  // the ground truth's translation
 };
-inline RegistrationError firstStepError(const std::string& folder,
-                                        cvo::StereoCloudBuilder& builder, cvo::CvoParams params) {
+inline RegistrationError firstStepError(const std::string& folder, cvo::StereoCloudBuilder& builder,
+                                        cvo::CvoParams params) {
   const cvo::KittiSequence sequence(folder);
   const auto target = kittiCloud(sequence, builder, 0);
   const auto source = kittiCloud(sequence, builder, 1);

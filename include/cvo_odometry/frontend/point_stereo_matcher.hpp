@@ -80,7 +80,7 @@ class PointStereoMatcher {
   cv::Ptr<cv::StereoSGBM> coarse_sgbm_;
   cv::Size size_;
   int first_row_ = 0;
-  int pad_ = 0;          // columns of padding left of the images (right: 32 + block / 2)
+  int pad_ = 0;           // columns of padding left of the images (right: 32 + block / 2)
   cv::Mat left_, right_;  // x-derivative images, padded: pixel (x, y) at (x + pad_, y - row0_)
   int row0_ = 0;          // the first image row the padded images hold
   cv::Mat coarse_;        // CV_16S, SGBM's fixed point (x16), rows from first_row_

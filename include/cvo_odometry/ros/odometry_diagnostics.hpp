@@ -89,7 +89,7 @@ class OdometryDiagnostics {
   bool lost_now_ = false;
   std::string lost_problem_, last_problem_, backend_;
   double latency_ms_ = 0.0, max_latency_ms_ = 0.0;
-  int threads_ = 0;                     // the last frame's CPU threads
+  int threads_ = 0;  // the last frame's CPU threads
   std::size_t one_thread_frames_ = 0;
   std::optional<double> clock_offset_;
   std::optional<DisparityOffsetEstimate> disparity_offset_;
