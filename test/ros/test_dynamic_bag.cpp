@@ -21,7 +21,6 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
-#include <std_srvs/SetBool.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -29,6 +28,7 @@
 #include "cvo_odometry/core/trajectory_evaluation.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
+#include "odometry_record.hpp"
 #include "rostest_main.hpp"
 
 namespace {
@@ -39,23 +39,6 @@ struct CloudSeen {
   bool labelled = false;
   std::size_t of_ignored_class = 0;
 };
-
-struct Collected {
-  std::mutex mutex;
-  std::vector<nav_msgs::Odometry> odometry;
-  std::vector<cvo_odometry::CvoIndicator> indicators;
-  std::vector<CloudSeen> clouds;
-};
-
-Eigen::Isometry3d poseOf(const nav_msgs::Odometry& msg) {
-  const auto& p = msg.pose.pose;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() << p.position.x, p.position.y, p.position.z;
-  pose.linear() =
-      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
-          .toRotationMatrix();
-  return pose;
-}
 
 bool hasField(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
   return std::any_of(cloud.fields.begin(), cloud.fields.end(),
@@ -77,17 +60,9 @@ TEST(DynamicBag, LabelledMovingObjectNeverGivesATrustedWrongPose) {
   pnh.param("ignored_class", ignored_class, ignored_class);
   pnh.param<std::string>("player", player, "/player");
 
-  Collected collected;
-  auto odom_sub =
-      nh.subscribe<nav_msgs::Odometry>("odom", 100, [&](const nav_msgs::Odometry::ConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(collected.mutex);
-        collected.odometry.push_back(*msg);
-      });
-  auto indicator_sub = nh.subscribe<cvo_odometry::CvoIndicator>(
-      "indicator", 100, [&](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(collected.mutex);
-        collected.indicators.push_back(*msg);
-      });
+  cvo_test::OdometryRecord collected;
+  collected.subscribe(nh);
+  std::vector<CloudSeen> clouds;  // guarded by collected.mutex
   auto cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
       "cloud/current", 100, [&](const sensor_msgs::PointCloud2::ConstPtr& msg) {
         CloudSeen seen;
@@ -100,25 +75,15 @@ TEST(DynamicBag, LabelledMovingObjectNeverGivesATrustedWrongPose) {
             seen.of_ignored_class += *label == ignored_class;
         }
         std::lock_guard<std::mutex> lock(collected.mutex);
-        collected.clouds.push_back(seen);
+        clouds.push_back(seen);
       });
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
 
   // Connected to the nodelet's output (the cloud too: it publishes clouds only to listeners),
   // then resume the paused player.
-  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(120.0);
-  while ((odom_sub.getNumPublishers() == 0 || indicator_sub.getNumPublishers() == 0 ||
-          cloud_sub.getNumPublishers() == 0) &&
-         ros::ok() && ros::WallTime::now() < connect_deadline)
-    ros::WallDuration(0.1).sleep();
-  ASSERT_GT(odom_sub.getNumPublishers(), 0u) << "no odometry publisher after 120 s";
-  ASSERT_GT(indicator_sub.getNumPublishers(), 0u) << "no indicator publisher after 120 s";
-  ASSERT_GT(cloud_sub.getNumPublishers(), 0u) << "no cloud/current publisher after 120 s";
-  ASSERT_TRUE(ros::service::waitForService(player + "/pause_playback", ros::Duration(120.0)));
-  std_srvs::SetBool resume;
-  resume.request.data = false;
-  ASSERT_TRUE(ros::service::call(player + "/pause_playback", resume));
+  ASSERT_NO_FATAL_FAILURE(cvo_test::resumeWhenConnected(
+      {&collected.odom_sub, &collected.indicator_sub, &cloud_sub}, player));
 
   // Until every frame's indicator came (the deadline is for a hang only).
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
@@ -135,7 +100,7 @@ TEST(DynamicBag, LabelledMovingObjectNeverGivesATrustedWrongPose) {
     const auto expected = static_cast<std::size_t>(
         std::count_if(collected.indicators.begin(), collected.indicators.end(),
                       [](const cvo_odometry::CvoIndicator& i) { return i.published; }));
-    return collected.odometry.size() >= expected && collected.clouds.size() >= expected;
+    return collected.odometry.size() >= expected && clouds.size() >= expected;
   };
   while (!published() && ros::ok() && ros::WallTime::now() < settle)
     ros::WallDuration(0.05).sleep();
@@ -169,7 +134,7 @@ TEST(DynamicBag, LabelledMovingObjectNeverGivesATrustedWrongPose) {
     EXPECT_NE(std::find(trusted_stamps.begin(), trusted_stamps.end(), msg.header.stamp.toSec()),
               trusted_stamps.end())
         << "a pose at " << msg.header.stamp << " for a frame not trusted";
-    estimate.append(msg.header.stamp.toSec(), poseOf(msg) * B);
+    estimate.append(msg.header.stamp.toSec(), cvo::fromPoseMsg(msg.pose.pose) * B);
   }
   const cvo::Trajectory ground_truth = cvo::readTumTrajectory(gt_path);
   const cvo::AssociatedPoses poses =
@@ -196,9 +161,9 @@ TEST(DynamicBag, LabelledMovingObjectNeverGivesATrustedWrongPose) {
   EXPECT_EQ(silent.failures, 0u);
 
   // The board's class never reaches the cloud; the cloud carries labels.
-  ASSERT_GE(collected.clouds.size(), trusted_stamps.size()) << "a cloud a published frame";
+  ASSERT_GE(clouds.size(), trusted_stamps.size()) << "a cloud a published frame";
   std::size_t ignored_points = 0;
-  for (const CloudSeen& cloud : collected.clouds) {
+  for (const CloudSeen& cloud : clouds) {
     EXPECT_TRUE(cloud.labelled) << "cloud at " << cloud.stamp << " has no label field";
     EXPECT_GT(cloud.points, 1000u) << "cloud at " << cloud.stamp;
     ignored_points += cloud.of_ignored_class;

@@ -26,7 +26,6 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
-#include <std_srvs/SetBool.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -34,26 +33,10 @@
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/ros/ros_conversions.hpp"
+#include "odometry_record.hpp"
 #include "rostest_main.hpp"
 
 namespace {
-
-struct Collected {
-  std::mutex mutex;
-  std::vector<nav_msgs::Odometry> odometry;
-  std::vector<cvo_odometry::CvoIndicator> indicators;
-  sensor_msgs::PointCloud2 last_cloud;  // cloud/current
-};
-
-Eigen::Isometry3d poseOf(const nav_msgs::Odometry& msg) {
-  const auto& p = msg.pose.pose;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() << p.position.x, p.position.y, p.position.z;
-  pose.linear() =
-      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
-          .toRotationMatrix();
-  return pose;
-}
 
 TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   ros::NodeHandle nh, pnh("~");
@@ -76,17 +59,9 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   bool expect_photometric_tracks = false;
   pnh.param("expect_photometric_tracks", expect_photometric_tracks, false);
 
-  Collected collected;
-  auto odom_sub =
-      nh.subscribe<nav_msgs::Odometry>("odom", 100, [&](const nav_msgs::Odometry::ConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(collected.mutex);
-        collected.odometry.push_back(*msg);
-      });
-  auto indicator_sub = nh.subscribe<cvo_odometry::CvoIndicator>(
-      "indicator", 100, [&](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(collected.mutex);
-        collected.indicators.push_back(*msg);
-      });
+  cvo_test::OdometryRecord collected;
+  collected.subscribe(nh);
+  sensor_msgs::PointCloud2 last_cloud;  // cloud/current, guarded by collected.mutex
   int label_classes = 0, ignored_class = -1;
   pnh.param("label_classes", label_classes, 0);
   pnh.param("ignored_class", ignored_class, -1);
@@ -95,27 +70,18 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
         "cloud/current", 5, [&](const sensor_msgs::PointCloud2::ConstPtr& msg) {
           std::lock_guard<std::mutex> lock(collected.mutex);
-          collected.last_cloud = *msg;
+          last_cloud = *msg;
         });
   }
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
 
-  // Connected to the nodelet's output: then resume the paused player (already running when the
-  // launch file did not pause it: the call then says so, which is fine).
-  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(120.0);
-  while ((odom_sub.getNumPublishers() == 0 || indicator_sub.getNumPublishers() == 0) && ros::ok() &&
-         ros::WallTime::now() < connect_deadline)
-    ros::WallDuration(0.1).sleep();
-  ASSERT_GT(odom_sub.getNumPublishers(), 0u) << "no odometry publisher after 120 s";
-  ASSERT_GT(indicator_sub.getNumPublishers(), 0u) << "no indicator publisher after 120 s";
-  std::string player;
+  // Connected to the nodelet's output: then resume the paused player.
+  std::string player, answer;
   pnh.param<std::string>("player", player, "/player");
-  ASSERT_TRUE(ros::service::waitForService(player + "/pause_playback", ros::Duration(120.0)));
-  std_srvs::SetBool resume;
-  resume.request.data = false;
-  ASSERT_TRUE(ros::service::call(player + "/pause_playback", resume));
-  std::cout << "player: " << resume.response.message << "\n";
+  ASSERT_NO_FATAL_FAILURE(cvo_test::resumeWhenConnected(
+      {&collected.odom_sub, &collected.indicator_sub}, player, &answer));
+  std::cout << "player: " << answer << "\n";
   std::string camera_frame;
   ASSERT_TRUE(pnh.getParam("camera_frame", camera_frame));
 
@@ -183,7 +149,7 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
     }
   }
   if (label_classes > 0) {
-    const auto& cloud = collected.last_cloud;
+    const auto& cloud = last_cloud;
     ASSERT_GT(cloud.width * cloud.height, 1000u) << "no current cloud received";
     std::set<int> classes;
     for (sensor_msgs::PointCloud2ConstIterator<std::uint16_t> label(cloud, "label");
@@ -208,7 +174,7 @@ TEST(OdometryBag, TracksTheFixtureWithinBounds) {
   const Eigen::Isometry3d B = cvo::fromTransformMsg(base_from_camera.transform);
   cvo::Trajectory estimate;
   for (const auto& msg : collected.odometry)
-    estimate.append(msg.header.stamp.toSec() - offset, poseOf(msg) * B);
+    estimate.append(msg.header.stamp.toSec() - offset, cvo::fromPoseMsg(msg.pose.pose) * B);
 
   // The nodelet and the offline runner run the same pipeline: the same poses on the same frames.
   std::string runner_path;
