@@ -58,6 +58,26 @@ Eigen::Isometry3d poseAt(const cvo::Trajectory& truth, double stamp) {
   return pose;
 }
 
+// A board of `spec` placed in the bundled TUM excerpt as cvo_make_dynamic places it (at the first
+// colour frame's ground-truth pose and stamp, the fr1 camera), with that frame's colour image.
+struct TumBoard {
+  cvo::Trajectory truth;
+  cvo::PinholeIntrinsics K;
+  double t0 = 0.0;
+  cv::Mat first_image;
+  cvo::MovingObject board;
+};
+
+TumBoard tumBoard(const cvo::TumSequence& sequence, const cvo::MovingObjectSpec& spec) {
+  cv::Mat image, raw;
+  sequence.load(0, &image, &raw);
+  cvo::Trajectory truth = cvo::readTumTrajectory((kTum / "groundtruth.txt").string());
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  const double t0 = sequence.frames()[0].rgb_stamp;
+  cvo::MovingObject board(spec, K, poseAt(truth, t0), t0, image);
+  return {std::move(truth), K, t0, image, std::move(board)};
+}
+
 // The depth (m) at which the ray through each pixel (undistorted by OpenCV, independently of
 // the renderer) meets the board's plane, seen from camera_from_object.
 cv::Mat planeDepth(const cvo::PinholeIntrinsics& K, const Eigen::Isometry3d& camera_from_object) {
@@ -85,13 +105,12 @@ cv::Mat planeDepth(const cvo::PinholeIntrinsics& K, const Eigen::Isometry3d& cam
 // the mask is.
 TEST(MovingObject, RenderedTumDepthIsTheBoards) {
   const cvo::TumSequence sequence(kTum.string());
-  const cvo::Trajectory truth = cvo::readTumTrajectory((kTum / "groundtruth.txt").string());
-  cv::Mat image, raw;
-  sequence.load(0, &image, &raw);
-  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
-  const double t0 = sequence.frames()[0].rgb_stamp;
   const cvo::MovingObjectSpec spec = personSpec();
-  const cvo::MovingObject board(spec, K, poseAt(truth, t0), t0, image);
+  const TumBoard placed = tumBoard(sequence, spec);
+  const cvo::Trajectory& truth = placed.truth;
+  const cvo::PinholeIntrinsics& K = placed.K;
+  const cvo::MovingObject& board = placed.board;
+  cv::Mat image, raw;
   for (const std::size_t k : {std::size_t{0}, std::size_t{20}}) {
     SCOPED_TRACE("frame " + std::to_string(k));
     sequence.load(k, &image, &raw);
@@ -292,12 +311,10 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
 
   const cvo::TumSequence made_sequence(out.string());
   ASSERT_EQ(made_sequence.frames().size(), frames);
-  const cvo::Trajectory truth = cvo::readTumTrajectory((kTum / "groundtruth.txt").string());
+  const TumBoard placed = tumBoard(source, personSpec());
+  const cvo::Trajectory& truth = placed.truth;
+  const cvo::MovingObject& board = placed.board;
   cv::Mat image, raw;
-  source.load(0, &image, &raw);
-  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
-  const double t0 = source.frames()[0].rgb_stamp;
-  const cvo::MovingObject board(personSpec(), K, poseAt(truth, t0), t0, image);
   for (const std::size_t k : {std::size_t{0}, frames / 2, frames - 1}) {
     SCOPED_TRACE("frame " + std::to_string(k));
     const cvo::TumFramePaths& f = source.frames()[k];
@@ -364,14 +381,11 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
 // --label-error 6 (0.312 listed, 0.330 covered): the table reads the mask labels() changed.
 TEST(MakeDynamic, ObjectTableMeasuresTheObjectNotItsLabels) {
   const cvo::TumSequence source(kTum.string());
-  const cvo::Trajectory truth = cvo::readTumTrajectory((kTum / "groundtruth.txt").string());
-  cv::Mat image, raw;
-  source.load(0, &image, &raw);
-  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
-  const double t0 = source.frames()[0].rgb_stamp;
-  const cvo::MovingObject board(personSpec(), K, poseAt(truth, t0), t0, image);
-  cv::Mat mask;
-  board.render(board.cameraFromObject(t0, poseAt(truth, t0)), &image, nullptr, &mask);
+  const TumBoard placed = tumBoard(source, personSpec());
+  const double t0 = placed.t0;
+  cv::Mat image = placed.first_image.clone(), mask;
+  placed.board.render(placed.board.cameraFromObject(t0, poseAt(placed.truth, t0)), &image, nullptr,
+                      &mask);
   const double share = cv::countNonZero(mask) / static_cast<double>(mask.total());
   for (const int error : {0, 6}) {
     SCOPED_TRACE("--label-error " + std::to_string(error));
