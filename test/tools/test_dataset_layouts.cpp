@@ -4,7 +4,6 @@
 // below the dataset folder, and a wrong depth scale made visible.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "command_output.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 
@@ -23,23 +23,12 @@ namespace fs = std::filesystem;
 const fs::path kData = CVO_TEST_DATA_DIR;
 const std::string kRunner = CVO_RUN_SEQUENCE;
 
-struct RunnerOutput {
-  int status = 0;
-  std::string output;  // stdout and stderr
-};
+using RunnerOutput = cvo_test::CommandOutput;
 
 // The runner with `args`, from `cwd` (so relative paths are not resolved by chance).
 RunnerOutput runner(const std::string& args, const fs::path& cwd = fs::temp_directory_path()) {
-  const std::string command =
-      "cd '" + cwd.string() + "' && '" + kRunner + "' --quiet --backend cpu " + args + " 2>&1";
-  RunnerOutput run;
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe))
-    run.output += buffer.data();
-  const int status = pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return cvo_test::runCommand("cd '" + cwd.string() + "' && '" + kRunner +
+                              "' --quiet --backend cpu " + args);
 }
 
 fs::path freshFolder(const std::string& name) {

@@ -4,9 +4,7 @@
 // cvo_run_sequence reads with --segmentation.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -17,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "command_output.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
@@ -251,22 +250,6 @@ TEST(MovingObject, LabelsLeaveTheMaskUnchanged) {
   }
 }
 
-struct Process {
-  int status = -1;
-  std::string output;
-};
-
-Process execute(const std::string& command) {
-  Process result;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  std::array<char, 4096> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe))
-    result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
 fs::path freshFolder(const std::string& name) {
   const fs::path folder = fs::path(testing::TempDir()) / ("cvo_make_dynamic_" + name);
   fs::remove_all(folder);
@@ -297,9 +280,9 @@ std::string readAll(const fs::path& path) {
 // one removed, it stops).
 TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
   const fs::path out = freshFolder("tum");
-  const Process made =
-      execute(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
-              out.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5");
+  const cvo_test::CommandOutput made = cvo_test::runCommand(
+      std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
+      out.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5");
   ASSERT_EQ(made.status, 0) << made.output;
   const cvo::TumSequence source(kTum.string());
   const std::size_t frames = source.frames().size();
@@ -365,12 +348,12 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
                              "' --quiet --backend cpu --tum '" + out.string() +
                              "' --segmentation '" + (out / "labels").string() +
                              "' --semantic-classes 2 --ignore-classes 1 --last 3";
-  const Process ran = execute(runner);
+  const cvo_test::CommandOutput ran = cvo_test::runCommand(runner);
   EXPECT_EQ(ran.status, 0) << ran.output;
   EXPECT_NE(ran.output.find("tracking:"), std::string::npos) << ran.output;
   // ... and it reads them from there: without one frame's labels it stops, naming the frame.
   fs::remove(out / "labels" / source.frames()[2].rgb_listed);
-  const Process missing = execute(runner);
+  const cvo_test::CommandOutput missing = cvo_test::runCommand(runner);
   EXPECT_NE(missing.status, 0) << missing.output;
   EXPECT_NE(missing.output.find("no segmentation image"), std::string::npos) << missing.output;
   fs::remove_all(out);
@@ -390,11 +373,12 @@ TEST(MakeDynamic, ObjectTableMeasuresTheObjectNotItsLabels) {
   for (const int error : {0, 6}) {
     SCOPED_TRACE("--label-error " + std::to_string(error));
     const fs::path out = freshFolder("table" + std::to_string(error));
-    const Process made = execute(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() +
-                                 "' --out '" + out.string() +
-                                 "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5"
-                                 " --label-error " +
-                                 std::to_string(error));
+    const cvo_test::CommandOutput made =
+        cvo_test::runCommand(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() +
+                             "' --out '" + out.string() +
+                             "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5"
+                             " --label-error " +
+                             std::to_string(error));
     ASSERT_EQ(made.status, 0) << made.output;
     const std::vector<std::string> rows = dataLines(out / "object.txt");
     ASSERT_EQ(rows.size(), source.frames().size());
@@ -438,7 +422,7 @@ double matchedDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Mat
 // the disparity of its depth within 0.5 px; and the runner reads the folder with its labels.
 TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
   const fs::path out = freshFolder("kitti");
-  const Process made = execute(
+  const cvo_test::CommandOutput made = cvo_test::runCommand(
       std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
       out.string() + "' --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6");
   ASSERT_EQ(made.status, 0) << made.output;
@@ -466,10 +450,10 @@ TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
               << "\n";
     EXPECT_NEAR(disparity, expected, 0.5);
   }
-  const Process ran =
-      execute(std::string("'") + CVO_RUN_SEQUENCE + "' --quiet --backend cpu --kitti '" +
-              out.string() + "' --segmentation '" + (out / "labels").string() +
-              "' --semantic-classes 2 --ignore-classes 1 --last 2");
+  const cvo_test::CommandOutput ran = cvo_test::runCommand(
+      std::string("'") + CVO_RUN_SEQUENCE + "' --quiet --backend cpu --kitti '" + out.string() +
+      "' --segmentation '" + (out / "labels").string() +
+      "' --semantic-classes 2 --ignore-classes 1 --last 2");
   EXPECT_EQ(ran.status, 0) << ran.output;
   EXPECT_NE(ran.output.find("tracking:"), std::string::npos) << ran.output;
   fs::remove_all(out);
@@ -479,9 +463,9 @@ TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
 // labelled run's baseline: the same view hidden, nothing moving).
 TEST(MakeDynamic, LabelsOnlyKeepsTheRecordedImages) {
   const fs::path tum = freshFolder("tum_labels_only");
-  const Process made_tum =
-      execute(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
-              tum.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --labels-only");
+  const cvo_test::CommandOutput made_tum = cvo_test::runCommand(
+      std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
+      tum.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --labels-only");
   ASSERT_EQ(made_tum.status, 0) << made_tum.output;
   const cvo::TumSequence source(kTum.string()), made(tum.string());
   ASSERT_EQ(made.frames().size(), source.frames().size());
@@ -500,7 +484,7 @@ TEST(MakeDynamic, LabelsOnlyKeepsTheRecordedImages) {
   fs::remove_all(tum);
 
   const fs::path kitti = freshFolder("kitti_labels_only");
-  const Process made_kitti = execute(
+  const cvo_test::CommandOutput made_kitti = cvo_test::runCommand(
       std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
       kitti.string() + "' --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --labels-only");
   ASSERT_EQ(made_kitti.status, 0) << made_kitti.output;
