@@ -30,10 +30,10 @@ class Latency : public cvo_test::TumTopicDriver {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kEventTimeout);
     while (ros::WallTime::now() < deadline) {
       {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard<std::mutex> lock(record_.mutex);
         // Stamps went through a double (header()): equal to well below a microsecond.
-        if (!indicators_.empty() &&
-            std::abs((indicators_.back().header.stamp - stamp).toSec()) < 1e-6)
+        if (!record_.indicators.empty() &&
+            std::abs((record_.indicators.back().header.stamp - stamp).toSec()) < 1e-6)
           return true;
       }
       ros::WallDuration(0.05).sleep();

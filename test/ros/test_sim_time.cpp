@@ -34,7 +34,7 @@ class SimTime : public cvo_test::TumTopicDriver {
     clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
     status_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
         "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
-          std::lock_guard<std::mutex> lock(mutex_);
+          std::lock_guard<std::mutex> lock(record_.mutex);
           nodelet_clock_ = std::max(nodelet_clock_, msg->header.stamp.toSec());
           for (const auto& status : msg->status) {
             Status s;
@@ -81,7 +81,7 @@ class SimTime : public cvo_test::TumTopicDriver {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kEventTimeout);
     while (ros::WallTime::now() < deadline) {
       {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard<std::mutex> lock(record_.mutex);
         if (nodelet_clock_ >= now) return true;
       }
       ros::WallDuration(0.05).sleep();
@@ -90,7 +90,7 @@ class SimTime : public cvo_test::TumTopicDriver {
   }
 
   std::vector<Status> rateStatuses() {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(record_.mutex);
     return rate_;
   }
   // Waits (moving the clock by `step` s every 0.1 s when step > 0) until a rate status from
@@ -243,7 +243,7 @@ TEST_F(SimTime, RateFirstFramesAndStampsFarFromTheClock) {
   ASSERT_NE(offset, "none yet");
   EXPECT_NEAR(std::stod(offset), 99.5, 0.6);
   EXPECT_EQ(diagnostic("latency (ms, stamp to publish)").rfind("unknown", 0), 0u);
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard<std::mutex> lock(record_.mutex);
   ASSERT_FALSE(odometry_status_.empty());
   const Status& latest = odometry_status_.back();
   EXPECT_EQ(latest.level, diagnostic_msgs::DiagnosticStatus::WARN);

@@ -26,6 +26,7 @@
 
 #include "cvo_odometry/CvoIndicator.h"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
+#include "odometry_record.hpp"
 
 namespace cvo_test {
 
@@ -51,26 +52,17 @@ class TumTopicDriver : public testing::Test {
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("rgb/camera_info", kQueue, true);
     depth_pub_ = nh_.advertise<sensor_msgs::Image>("depth_registered/image_rect", kQueue);
     if (segmentation) labels_pub_ = nh_.advertise<sensor_msgs::Image>("segmentation/image", kQueue);
-    indicator_sub_ = nh_.subscribe<cvo_odometry::CvoIndicator>(
-        "indicator", kQueue, [this](const cvo_odometry::CvoIndicator::ConstPtr& msg) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          indicators_.push_back(*msg);
-        });
-    odom_sub_ = nh_.subscribe<nav_msgs::Odometry>("odom", kQueue,
-                                                  [this](const nav_msgs::Odometry::ConstPtr& msg) {
-                                                    std::lock_guard<std::mutex> lock(mutex_);
-                                                    odoms_.push_back(*msg);
-                                                  });
+    record_.subscribe(nh_);
     cloud_sub_ = nh_.subscribe<sensor_msgs::PointCloud2>(
         "cloud/current", 2, [this](const sensor_msgs::PointCloud2::ConstPtr& msg) {
-          std::lock_guard<std::mutex> lock(mutex_);
+          std::lock_guard<std::mutex> lock(record_.mutex);
           cloud_fields_.clear();
           for (const auto& f : msg->fields)
             cloud_fields_.push_back(f.name);
         });
     diagnostics_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
         "/diagnostics", 10, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
-          std::lock_guard<std::mutex> lock(mutex_);
+          std::lock_guard<std::mutex> lock(record_.mutex);
           for (const auto& status : msg->status) {
             if (status.name.find("odometry") == std::string::npos) continue;
             for (const auto& kv : status.values)
@@ -83,8 +75,9 @@ class TumTopicDriver : public testing::Test {
       return depth_pub_.getNumSubscribers() > 0 && rgb_pub_.getNumSubscribers() > 0 &&
              info_pub_.getNumSubscribers() > 0 &&
              (!segmentation || labels_pub_.getNumSubscribers() > 0) &&
-             indicator_sub_.getNumPublishers() > 0 && odom_sub_.getNumPublishers() > 0 &&
-             cloud_sub_.getNumPublishers() > 0 && !diagnostic("frames").empty();
+             record_.indicator_sub.getNumPublishers() > 0 &&
+             record_.odom_sub.getNumPublishers() > 0 && cloud_sub_.getNumPublishers() > 0 &&
+             !diagnostic("frames").empty();
     };
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kConnectTimeout);
     while (!connected() && ros::ok() && ros::WallTime::now() < deadline)
@@ -152,25 +145,25 @@ class TumTopicDriver : public testing::Test {
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
     while (ros::WallTime::now() < deadline) {
       {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (indicators_.size() >= count) return indicators_.size();
+        std::lock_guard<std::mutex> lock(record_.mutex);
+        if (record_.indicators.size() >= count) return record_.indicators.size();
       }
       ros::WallDuration(0.05).sleep();
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    return indicators_.size();
+    std::lock_guard<std::mutex> lock(record_.mutex);
+    return record_.indicators.size();
   }
 
   cvo_odometry::CvoIndicator indicator(std::size_t k) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return indicators_.at(k);
+    std::lock_guard<std::mutex> lock(record_.mutex);
+    return record_.indicators.at(k);
   }
   std::vector<nav_msgs::Odometry> odometry() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return odoms_;
+    std::lock_guard<std::mutex> lock(record_.mutex);
+    return record_.odometry;
   }
   std::vector<std::string> cloudFields() {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(record_.mutex);
     return cloud_fields_;
   }
   // Waits until the nodelet's diagnostics count `count` skipped frames (it publishes them once a
@@ -184,7 +177,7 @@ class TumTopicDriver : public testing::Test {
 
   // The latest value of a key of the nodelet's diagnostics ("" if not seen yet).
   std::string diagnostic(const std::string& key) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(record_.mutex);
     const auto it = diagnostics_.find(key);
     return it == diagnostics_.end() ? "" : it->second;
   }
@@ -207,10 +200,8 @@ class TumTopicDriver : public testing::Test {
   int infos_ = 0;
   std::map<std::size_t, cv::Mat> images_, depths_;
   ros::Publisher rgb_pub_, info_pub_, depth_pub_, labels_pub_;
-  ros::Subscriber indicator_sub_, odom_sub_, cloud_sub_, diagnostics_sub_;
-  std::mutex mutex_;
-  std::vector<cvo_odometry::CvoIndicator> indicators_;
-  std::vector<nav_msgs::Odometry> odoms_;
+  ros::Subscriber cloud_sub_, diagnostics_sub_;
+  OdometryRecord record_;  // odom and indicator; its mutex guards the members below too
   std::vector<std::string> cloud_fields_;
   std::map<std::string, std::string> diagnostics_;
 };
