@@ -160,12 +160,9 @@ PointStereoMatcher::PointStereoMatcher(const PointMatcherOptions& options) : opt
 
 void PointStereoMatcher::prepare(const cv::Mat& left, const cv::Mat& right, int first_row,
                                  const std::function<void()>& beside) {
-  if (left.empty() || right.empty()) throw std::invalid_argument("stereo image is empty");
-  if (left.size() != right.size() || left.type() != right.type()) {
-    throw std::invalid_argument("left image is " + std::to_string(left.cols) + "x" +
-                                std::to_string(left.rows) + " but right is " +
-                                std::to_string(right.cols) + "x" + std::to_string(right.rows) +
-                                (left.size() == right.size() ? " of another type" : ""));
+  checkStereoPair(left, right);
+  if (left.type() != right.type()) {
+    throw std::invalid_argument("left and right images are of different types");
   }
   if (first_row < 0 || first_row >= left.rows) {
     throw std::invalid_argument("first row " + std::to_string(first_row) + " is outside the " +

@@ -117,12 +117,7 @@ void StereoCloudBuilder::completeDepth(const PointStereoMatcher& matcher, double
 
 cv::Mat StereoCloudBuilder::pointDepth(const StereoFrame& frame,
                                        PointStereoMatcher& matcher) const {
-  if (frame.left.size() != frame.right.size()) {
-    throw std::invalid_argument("left image is " + std::to_string(frame.left.cols) + "x" +
-                                std::to_string(frame.left.rows) + " but right is " +
-                                std::to_string(frame.right.cols) + "x" +
-                                std::to_string(frame.right.rows));
-  }
+  checkStereoPair(frame.left, frame.right);
   options_.matcher.checkImageSize(frame.left.cols, frame.left.rows);
   const cv::Mat grey = toGrey(frame.left);
   const int first =

@@ -75,13 +75,17 @@ StereoMatcher::StereoMatcher(const StereoMatcherOptions& options) : options_(opt
       options_.speckle_window_size, options_.speckle_range, mode);
 }
 
-cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right) const {
+void checkStereoPair(const cv::Mat& left, const cv::Mat& right) {
   if (left.empty() || right.empty()) throw std::invalid_argument("stereo image is empty");
   if (left.size() != right.size()) {
     throw std::invalid_argument("left image is " + std::to_string(left.cols) + "x" +
                                 std::to_string(left.rows) + " but right is " +
                                 std::to_string(right.cols) + "x" + std::to_string(right.rows));
   }
+}
+
+cv::Mat StereoMatcher::disparity(const cv::Mat& left, const cv::Mat& right) const {
+  checkStereoPair(left, right);
   // Before OpenCV, which would not refuse it (StereoMatcherOptions::minImageWidth).
   options_.checkImageSize(left.cols, left.rows);
   cv::Mat fixed_point;  // CV_16S, disparity * 16

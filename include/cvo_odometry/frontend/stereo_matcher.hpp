@@ -51,6 +51,10 @@ struct StereoMatcherOptions {
   void checkImageSize(int cols, int rows) const;
 };
 
+// Throws std::invalid_argument, naming the problem, when an image of a stereo pair is empty or
+// the two differ in size.
+void checkStereoPair(const cv::Mat& left, const cv::Mat& right);
+
 class StereoMatcher {
  public:
   explicit StereoMatcher(const StereoMatcherOptions& options);
