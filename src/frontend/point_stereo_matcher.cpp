@@ -222,20 +222,6 @@ void PointStereoMatcher::prepare(const cv::Mat& left, const cv::Mat& right, int 
   }
 }
 
-cv::Mat PointStereoMatcher::coarseDisparity() const {
-  if (coarse_.empty()) return cv::Mat();
-  cv::Mat out(coarse_.size(), CV_32FC1);
-  const int invalid_below = coarse_sgbm_->getMinDisparity() * 16;
-  const float scale = static_cast<float>(1 << options_.coarse_level) / 16.0f;
-  for (int v = 0; v < coarse_.rows; ++v) {
-    for (int u = 0; u < coarse_.cols; ++u) {
-      const std::int16_t d = coarse_.at<std::int16_t>(v, u);
-      out.at<float>(v, u) = d < invalid_below ? kNaN : d * scale;
-    }
-  }
-  return out;
-}
-
 bool PointStereoMatcher::searchInterval(int x, int y, int* lo, int* hi) const {
   const int h = options_.block_size / 2;
   // Disparities whose window lies inside the right image, one beyond either end of the

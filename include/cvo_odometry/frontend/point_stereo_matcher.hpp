@@ -52,7 +52,6 @@ class PointStereoMatcher {
                const std::function<void()>& beside = {});
   bool prepared() const { return !left_.empty(); }
   cv::Size size() const { return size_; }
-  int firstRow() const { return first_row_; }
 
   // The disparity (px, left image) at each pixel, NaN where it has none: its window leaves the
   // prepared rows or the image, no disparity of the range fits in the right image, the coarse
@@ -61,10 +60,6 @@ class PointStereoMatcher {
   // image. Splits the pixels over OpenCV's threads.
   std::vector<float> match(const std::vector<cv::Point>& pixels) const;
   float match(cv::Point pixel) const;
-
-  // The coarse disparity (px at full resolution, CV_32FC1 of the coarse size, NaN where none)
-  // of the prepared rows; empty at coarse level 0.
-  cv::Mat coarseDisparity() const;
 
   const PointMatcherOptions& options() const { return options_; }
 
