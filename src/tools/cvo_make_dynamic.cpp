@@ -141,25 +141,27 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
   rgb_list << "# timestamp filename\n";
   depth_list << "# timestamp filename\n";
   constexpr double kUnitsPerMetre = 5000.0;  // TUM's depth PNGs
+  const bool labels_only = cli.has("labels-only");
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const cvo::TumFramePaths& f = frames[k];
     sequence.load(k, &image, &depth);
     // Colour and labels at the colour image's time, depth at the depth image's: each shows the
     // object where it was when that image was taken.
     cv::Mat mask;
-    const bool labels_only = cli.has("labels-only");
     cv::Mat painted = labels_only ? image.clone() : image;  // a scratch canvas for labels only
     object.render(object.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp, max_gap)),
                   &painted, nullptr, &mask);
-    cv::Mat object_depth;
-    cv::Mat depth_image = image.clone();  // a scratch canvas; only the depth is kept
-    object.render(object.cameraFromObject(f.depth_stamp, poseAt(truth, f.depth_stamp, max_gap)),
-                  &depth_image, &object_depth, nullptr);
-    for (int v = 0; v < depth.rows; ++v) {
-      for (int u = 0; u < depth.cols; ++u) {
-        const float z = object_depth.at<float>(v, u);
-        if (std::isfinite(z) && !labels_only) {
-          depth.at<std::uint16_t>(v, u) = cv::saturate_cast<std::uint16_t>(z * kUnitsPerMetre);
+    if (!labels_only) {
+      cv::Mat object_depth;
+      cv::Mat depth_image = image.clone();  // a scratch canvas; only the depth is kept
+      object.render(object.cameraFromObject(f.depth_stamp, poseAt(truth, f.depth_stamp, max_gap)),
+                    &depth_image, &object_depth, nullptr);
+      for (int v = 0; v < depth.rows; ++v) {
+        for (int u = 0; u < depth.cols; ++u) {
+          const float z = object_depth.at<float>(v, u);
+          if (std::isfinite(z)) {
+            depth.at<std::uint16_t>(v, u) = cv::saturate_cast<std::uint16_t>(z * kUnitsPerMetre);
+          }
         }
       }
     }
@@ -195,6 +197,7 @@ void makeKitti(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, c
   const bool grey =
       cv::imread(folder + "/image_0/" + sequence.imageName(0), cv::IMREAD_UNCHANGED).channels() ==
       1;
+  const bool labels_only = cli.has("labels-only");
   for (std::size_t k = 0; k < sequence.size(); ++k) {
     sequence.load(k, &left, &right, nullptr);
     if (grey) {
@@ -206,7 +209,7 @@ void makeKitti(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, c
         object.cameraFromObject(stamp, poseAt(truth, stamp, max_gap));
     // Both cameras see the same board: a disparity consistent with its depth.
     cv::Mat mask;
-    if (cli.has("labels-only")) {
+    if (labels_only) {
       cv::Mat scratch = left.clone();
       object.render(camera_from_object, &scratch, nullptr, &mask);
     } else {
