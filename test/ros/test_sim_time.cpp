@@ -11,6 +11,7 @@
 // Time only moves when this node moves it, so nothing depends on the machine's speed.
 #include <atomic>
 #include <cmath>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -35,7 +36,7 @@ class SimTime : public cvo_test::TumTopicDriver {
     status_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
         "/diagnostics", 100, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
           std::lock_guard<std::mutex> lock(record_.mutex);
-          nodelet_clock_ = std::max(nodelet_clock_, msg->header.stamp.toSec());
+          nodelet_clock_ = msg->header.stamp.toSec();
           for (const auto& status : msg->status) {
             Status s;
             s.level = status.level;
@@ -49,8 +50,11 @@ class SimTime : public cvo_test::TumTopicDriver {
     clock_thread_ = std::thread([this] {
       // Published again and again (a late subscriber gets it); moving only in free run.
       while (!stop_) {
-        if (free_run_) now_ = now_ + 0.01;
-        publishClock();
+        {
+          std::lock_guard<std::mutex> lock(clock_mutex_);
+          if (free_run_) now_ = now_ + 0.01;
+          publishClockLocked();
+        }
         ros::WallDuration(0.01).sleep();
       }
     });
@@ -64,15 +68,19 @@ class SimTime : public cvo_test::TumTopicDriver {
     return text.size() >= tail.size() &&
            text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
   }
-  void publishClock() {
+  // Under clock_mutex_: reading the time and publishing it are one step, so that this thread and
+  // the clock thread never publish an older time after a newer one (the nodelet's clock would go
+  // back for a moment and a frame would arrive at the old time).
+  void publishClockLocked() {
     rosgraph_msgs::Clock clock;
     clock.clock = ros::Time(now_.load());
     clock_pub_.publish(clock);
   }
   void setClock(double now) {
+    std::lock_guard<std::mutex> lock(clock_mutex_);
     free_run_ = false;
     now_ = now;
-    publishClock();
+    publishClockLocked();
   }
 
   // Waits until the nodelet's diagnostics are stamped at `now` or later: its clock has come
@@ -135,7 +143,9 @@ class SimTime : public cvo_test::TumTopicDriver {
   ros::Publisher clock_pub_;
   ros::Subscriber status_sub_;
   std::vector<Status> rate_, odometry_status_;
-  double nodelet_clock_ = 0.0;  // the latest diagnostics' stamp
+  // The latest diagnostics' stamp (not the largest: the clock goes back to 1000 after 2000).
+  double nodelet_clock_ = 0.0;
+  std::mutex clock_mutex_;
   std::atomic<double> now_{0.0};
   std::atomic<bool> free_run_{false}, stop_{false};
   std::thread clock_thread_;
@@ -148,8 +158,11 @@ TEST_F(SimTime, RateFirstFramesAndStampsFarFromTheClock) {
     ros::WallDuration(0.1).sleep();
   ASSERT_GT(status_sub_.getNumPublishers(), 0u);
   // The clock starts decades after 0, as a bag's does, and runs while this node connects.
-  now_ = 2000.0;
-  free_run_ = true;
+  {
+    std::lock_guard<std::mutex> lock(clock_mutex_);
+    now_ = 2000.0;
+    free_run_ = true;
+  }
   std::vector<std::size_t> frames;
   for (std::size_t k = 0; k < 22; ++k)
     frames.push_back(k);
