@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace cvo {
 
@@ -129,13 +130,34 @@ CpuBackend::CpuBackend(int num_threads) : pool_(resolvedThreadCount(num_threads)
 
 void CpuBackend::setProblem(const LabeledCloud& target, const LabeledCloud& source,
                             const CvoParams& params) {
-  target_ = &target;
-  source_ = &source;
+  whole_target_ = &target;
+  whole_source_ = &source;
   constants_ = makeKernelConstants(params, source.semanticClasses());
   constant_appearance_ = !constants_.use_color && constants_.semantic_classes == 0;
   cutoff2_ = retainedScaledDistance2(params);
-  direct_ell_ = -1.0;
   ell_min_ = params.ell_min;
+  usePoints(target, source);
+}
+
+void CpuBackend::useSubsets(const CloudSubsets& subsets) {
+  if (!whole_target_) throw std::logic_error("useSubsets before setProblem");
+  const LabeledCloud* target = whole_target_;
+  const LabeledCloud* source = whole_source_;
+  if (!subsets.wholeTarget()) {
+    subsets.targetInto(*whole_target_, target_subset_);
+    target = &target_subset_;
+  }
+  if (!subsets.wholeSource(whole_source_->size())) {
+    subsets.sourceInto(*whole_source_, source_subset_);
+    source = &source_subset_;
+  }
+  usePoints(*target, *source);
+}
+
+void CpuBackend::usePoints(const LabeledCloud& target, const LabeledCloud& source) {
+  target_ = &target;
+  source_ = &source;
+  direct_ell_ = -1.0;
   grid_radius_ = -1.0f;
   // Blocks keep their storage across problems, those beyond a smaller problem's count too: the
   // registration's levels, its self products and each frame alternate problem sizes, and a

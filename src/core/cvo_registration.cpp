@@ -95,7 +95,9 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   }
   target_ = &target;
   source_ = &source;
-  target_stride_ = source_count_ = 0;
+  // The whole clouds once (a device copies them here); each level then names its subsets.
+  backend_->setProblem(target, source, params_);
+  subsets_ = CloudSubsets{};
   first_weight_at_final_ = -1.0;
   auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
   if (failover) failover->restore();  // each registration tries the GPU again
@@ -329,21 +331,13 @@ double CvoRegistration::useCloudsForLengthscale(double ell) {
   // The source: every stride-th point, or fewer when the budget asks for it.
   const std::size_t strided_count = (source_->size() + stride - 1) / stride;
   const std::size_t source_count = std::min(strided_count, sourceBudget(*source_));
-  if (stride != target_stride_ || source_count != source_count_) {
-    // Into the members' storage: new clouds at every level cost 1.0 ms a registration at 15k
-    // points (`cvo_benchmark --time-calls`, its "rest").
-    if (stride != target_stride_ && stride > 1) target_->stridedInto(stride, strided_target_);
-    if (source_count != source_count_ && source_count < source_->size()) {
-      if (source_count == strided_count) {
-        source_->stridedInto(stride, subsampled_source_);
-      } else {
-        source_->thinnedInto(source_count, subsampled_source_);
-      }
-    }
-    target_stride_ = stride;
-    source_count_ = source_count;
-    backend_->setProblem(stride > 1 ? strided_target_ : *target_,
-                         source_count < source_->size() ? subsampled_source_ : *source_, params_);
+  CloudSubsets subsets;
+  subsets.target_stride = stride;
+  subsets.source_stride = stride;
+  if (source_count < strided_count) subsets.source_count = source_count;
+  if (subsets != subsets_) {
+    backend_->useSubsets(subsets);
+    subsets_ = subsets;
   }
   return static_cast<double>(source_->size()) / static_cast<double>(source_count);
 }
@@ -356,7 +350,6 @@ double CvoRegistration::innerProduct(const LabeledCloud& target, const LabeledCl
                                      const Eigen::Isometry3d& T, double ell) {
   checkInputs(target, source);
   backend_->setProblem(target, source, params_);
-  target_stride_ = source_count_ = 0;  // the backend no longer holds align()'s clouds
   return backend_->oneOffMoments(T, ell).weight;
 }
 

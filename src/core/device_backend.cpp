@@ -26,6 +26,11 @@ void DeviceBackend<System>::setProblem(const LabeledCloud& target, const Labeled
 }
 
 template <DeviceSystem System>
+void DeviceBackend<System>::useSubsets(const CloudSubsets& subsets) {
+  device_.useSubsets(subsets.target_stride, subsets.source_stride, subsets.source_count);
+}
+
+template <DeviceSystem System>
 kernels::MomentSums DeviceBackend<System>::moments(const Eigen::Isometry3d& T, double ell) {
   float pose[12];
   toRowMajor3x4(T, pose);

@@ -28,6 +28,7 @@ auto FailoverBackend::run(Call&& call) {
   if (!secondary_ready_) {
     if (!target_) throw std::logic_error("backend used before setProblem");
     secondary_->setProblem(*target_, *source_, params_);
+    secondary_->useSubsets(subsets_);
     secondary_ready_ = true;
   }
   return call(*secondary_);
@@ -38,6 +39,7 @@ void FailoverBackend::setProblem(const LabeledCloud& target, const LabeledCloud&
   target_ = &target;
   source_ = &source;
   params_ = params;
+  subsets_ = CloudSubsets{};
   secondary_ready_ = false;
   if (failed_) {
     secondary_->setProblem(target, source, params);
@@ -46,6 +48,18 @@ void FailoverBackend::setProblem(const LabeledCloud& target, const LabeledCloud&
   }
   run([&](RegistrationBackend& b) {
     b.setProblem(target, source, params);
+    return 0;
+  });
+}
+
+void FailoverBackend::useSubsets(const CloudSubsets& subsets) {
+  subsets_ = subsets;
+  if (failed_) {
+    if (secondary_ready_) secondary_->useSubsets(subsets);
+    return;
+  }
+  run([&](RegistrationBackend& b) {
+    b.useSubsets(subsets);
     return 0;
   });
 }

@@ -24,6 +24,10 @@ void FaultInjectionBackend::setProblem(const LabeledCloud& target, const Labeled
   inner_->setProblem(target, source, params);
 }
 
+void FaultInjectionBackend::useSubsets(const CloudSubsets& subsets) {
+  inner_->useSubsets(subsets);
+}
+
 kernels::MomentSums FaultInjectionBackend::moments(const Eigen::Isometry3d& T, double ell) {
   countCall();
   return inner_->moments(T, ell);

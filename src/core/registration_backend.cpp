@@ -26,4 +26,16 @@ void toRowMajor3x4(const Eigen::Isometry3d& T, float* out) {
   }
 }
 
+void CloudSubsets::targetInto(const LabeledCloud& target, LabeledCloud& out) const {
+  target.stridedInto(target_stride, out);
+}
+
+void CloudSubsets::sourceInto(const LabeledCloud& source, LabeledCloud& out) const {
+  if (source_count == 0) {
+    source.stridedInto(source_stride, out);
+  } else {
+    source.thinnedInto(source_count, out);
+  }
+}
+
 }  // namespace cvo

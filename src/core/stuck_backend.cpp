@@ -9,6 +9,13 @@ void StuckBackend::setProblem(const LabeledCloud& target, const LabeledCloud&,
   inner_->setProblem(target, target, params);  // the target against itself, aligned
 }
 
+void StuckBackend::useSubsets(const CloudSubsets& subsets) {
+  CloudSubsets same = subsets;  // the source is the target: the same points of it
+  same.source_stride = subsets.target_stride;
+  same.source_count = 0;
+  inner_->useSubsets(same);
+}
+
 kernels::MomentSums StuckBackend::moments(const Eigen::Isometry3d&, double ell) {
   return inner_->moments(Eigen::Isometry3d::Identity(), ell);
 }

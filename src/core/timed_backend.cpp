@@ -25,6 +25,13 @@ void TimedBackend::setProblem(const LabeledCloud& target, const LabeledCloud& so
   });
 }
 
+void TimedBackend::useSubsets(const CloudSubsets& subsets) {
+  timed(kUseSubsets, [&] {
+    inner_->useSubsets(subsets);
+    return 0;
+  });
+}
+
 kernels::MomentSums TimedBackend::moments(const Eigen::Isometry3d& T, double ell) {
   return timed(kMoments, [&] { return inner_->moments(T, ell); });
 }
@@ -46,6 +53,8 @@ const char* TimedBackend::callName(Call call) {
   switch (call) {
     case kSetProblem:
       return "setProblem";
+    case kUseSubsets:
+      return "useSubsets";
     case kMoments:
       return "moments";
     case kOneOffMoments:

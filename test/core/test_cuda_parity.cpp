@@ -246,6 +246,10 @@ class Lockstep : public cvo::RegistrationBackend {
     cpu_.setProblem(target, source, params);
     device_->setProblem(target, source, params);
   }
+  void useSubsets(const cvo::CloudSubsets& subsets) override {
+    cpu_.useSubsets(subsets);
+    device_->useSubsets(subsets);
+  }
   cvo::kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override {
     const auto c = cpu_.moments(T, ell);
     compare(device_->moments(T, ell), c, "moments", ell);
@@ -419,11 +423,54 @@ TEST_P(DeviceTest, DeviceWorkCountsTheRegistrationsCalls) {
                            timed.tally(Call::kTaylor).calls + timed.tally(Call::kCurvature).calls;
   EXPECT_GT(evaluations, 0);
   EXPECT_EQ(work.evaluations, evaluations);
-  EXPECT_EQ(work.uploads, 2 * timed.tally(Call::kSetProblem).calls);
-  EXPECT_GE(work.grid_builds, 1);
+  // The clouds are copied once (target and source); the levels are subsets of them on the device.
+  EXPECT_EQ(timed.tally(Call::kSetProblem).calls, 1);
+  EXPECT_EQ(work.uploads, 2);
+  EXPECT_GE(timed.tally(Call::kUseSubsets).calls, 2);
+  EXPECT_GE(work.grid_builds, 2);
   EXPECT_LE(work.grid_builds, evaluations);
   // A grid build: cells, sequence, sort, cell starts and a gather per array (positions, colours).
   EXPECT_EQ(work.algorithms, work.evaluations + 6 * work.grid_builds);
+}
+
+// A keyframe is the target of every frame's registration, with the frames' self products in
+// between: kept on the device with its grids, it is uploaded once; a cloud changed in place is
+// uploaded again. Every result is a fresh backend's, bit for bit.
+TEST_P(DeviceTest, AKeptTargetIsUploadedOnceAndAChangedOneAgain) {
+  LabeledCloud target = cvo::readCloud(tumFile("frame10_3000"));
+  const LabeledCloud source = cvo::readCloud(tumFile("frame11_3000"));
+  const LabeledCloud moved =
+      source.transformed(Eigen::Isometry3f(Eigen::Translation3f(0.01f, -0.005f, 0.0f)));
+  cvo::CvoParams params;
+  params.use_color = true;
+  auto timed_backend = std::make_unique<cvo::TimedBackend>(device());
+  const cvo::TimedBackend& timed = *timed_backend;
+  cvo::CvoRegistration kept(params, std::move(timed_backend));
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  const auto fresh = [&](const LabeledCloud& t, const LabeledCloud& s) {
+    cvo::CvoRegistration registration(params, device());
+    return registration.align(t, s, I).transform;
+  };
+
+  EXPECT_TRUE(kept.align(target, source, I).transform.matrix() == fresh(target, source).matrix());
+  const cvo::DeviceWork first = *timed.deviceWork();
+  EXPECT_EQ(first.uploads, 2);
+  EXPECT_GE(first.grid_builds, 2);
+  kept.selfProduct(source, params.ell_min);  // another target, as the odometry's cosine sets
+  const cvo::DeviceWork between = *timed.deviceWork();
+  EXPECT_EQ(between.uploads - first.uploads, 2);
+
+  EXPECT_TRUE(kept.align(target, moved, I).transform.matrix() == fresh(target, moved).matrix());
+  const cvo::DeviceWork second = *timed.deviceWork();
+  EXPECT_EQ(second.uploads - between.uploads, 1) << "the source only: the target is kept";
+  EXPECT_LT(second.grid_builds - between.grid_builds, first.grid_builds)
+      << "the levels' grids of the kept target are kept";
+
+  target = moved;  // the same object and size, other bits
+  EXPECT_TRUE(kept.align(target, source, I).transform.matrix() == fresh(target, source).matrix());
+  const cvo::DeviceWork changed = *timed.deviceWork();
+  EXPECT_EQ(changed.uploads - second.uploads, 2) << "a target changed in place is uploaded again";
+  EXPECT_GE(changed.grid_builds - second.grid_builds, 1);
 }
 
 TEST_P(DeviceTest, EmptyAndSinglePointClouds) {

@@ -293,6 +293,7 @@ class ShiftedSourceBackend : public cvo::RegistrationBackend {
     shifted_ = source.transformed(Eigen::Isometry3f(Eigen::Translation3f(100.0f, 0.0f, 0.0f)));
     inner_->setProblem(target, shifted_, params);
   }
+  void useSubsets(const cvo::CloudSubsets& subsets) override { inner_->useSubsets(subsets); }
   cvo::kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override {
     return inner_->moments(T, ell);
   }

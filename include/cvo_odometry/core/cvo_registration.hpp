@@ -78,10 +78,8 @@ class CvoRegistration {
   std::string backend_note_;
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
-  LabeledCloud strided_target_;
-  LabeledCloud subsampled_source_;
-  // The clouds align() gave the backend last; 0: none yet in this align().
-  std::size_t target_stride_ = 0, source_count_ = 0;
+  // The subsets of align()'s clouds the backend uses now.
+  CloudSubsets subsets_;
   // F at the guess from a procrustes run that never left its first lengthscale, else -1.
   double first_weight_at_final_ = -1.0;
 };

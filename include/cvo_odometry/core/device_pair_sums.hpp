@@ -8,6 +8,7 @@
 // Every call throws std::runtime_error naming what failed (a CUDA error, device memory).
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -26,7 +27,7 @@ struct DeviceWork {
   long algorithms = 0;   // Thrust algorithms run, grid builds' and evaluations' together
   long grid_builds = 0;  // the target's neighbour grid (4 algorithms and a gather per array)
   long evaluations = 0;  // moments, Taylor or curvature sums: one reduction each
-  long uploads = 0;      // clouds copied to the device
+  long uploads = 0;      // clouds copied to the device (once a registration, not a level)
 };
 
 template <DeviceSystem System>
@@ -42,6 +43,11 @@ class DevicePairSums {
   // `classes` floats a point or null.
   void setCloud(bool target, const float* positions, const float* colors, const float* semantics,
                 int count, int classes);
+  // From the next evaluation on, sum over the target's every target_stride-th point and the
+  // source's every source_stride-th, or source_count points spread evenly over it where
+  // source_count is not 0 (CloudSubsets): indices into the clouds on the device, no upload.
+  // setCloud starts again from every point.
+  void useSubsets(std::size_t target_stride, std::size_t source_stride, std::size_t source_count);
   void setConstants(const kernels::KernelConstants& constants, double cutoff2);
   // Sums with the source moved by the row-major 3x4 `pose`, at lengthscale `ell`.
   kernels::MomentSums moments(const float* pose, double ell);

@@ -18,6 +18,7 @@ class FailoverBackend : public RegistrationBackend {
   std::string name() const override;
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
+  void useSubsets(const CloudSubsets& subsets) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
@@ -46,6 +47,7 @@ class FailoverBackend : public RegistrationBackend {
   const LabeledCloud* target_ = nullptr;
   const LabeledCloud* source_ = nullptr;
   CvoParams params_;
+  CloudSubsets subsets_;
 };
 
 }  // namespace cvo

@@ -17,6 +17,7 @@ class FaultInjectionBackend : public RegistrationBackend {
   std::string name() const override;
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
+  void useSubsets(const CloudSubsets& subsets) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;

@@ -3,6 +3,7 @@
 // every backend (up to floating-point rounding).
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -18,15 +19,42 @@
 
 namespace cvo {
 
+// Which points of setProblem's clouds the following calls sum over (a registration's coarse
+// levels and its source budget): the target's every target_stride-th point, from the first; the
+// source's every source_stride-th point, or, where source_count is not 0, source_count points
+// spread evenly over the whole source (LabeledCloud::thinnedInto's points). The default: every
+// point of both.
+struct CloudSubsets {
+  std::size_t target_stride = 1;
+  std::size_t source_stride = 1;
+  std::size_t source_count = 0;
+
+  bool operator==(const CloudSubsets& o) const {
+    return target_stride == o.target_stride && source_stride == o.source_stride &&
+           source_count == o.source_count;
+  }
+  bool operator!=(const CloudSubsets& o) const { return !(*this == o); }
+  // The subsets as copies (a backend that does not index the whole clouds).
+  void targetInto(const LabeledCloud& target, LabeledCloud& out) const;
+  void sourceInto(const LabeledCloud& source, LabeledCloud& out) const;
+  bool wholeTarget() const { return target_stride <= 1; }
+  bool wholeSource(std::size_t source_size) const {
+    return source_count == 0 ? source_stride <= 1 : source_count >= source_size;
+  }
+};
+
 class RegistrationBackend {
  public:
   virtual ~RegistrationBackend() = default;
   virtual std::string name() const = 0;
 
-  // The clouds and kernel settings for the following calls. The clouds must stay alive and
-  // unchanged until the next setProblem.
+  // The clouds and kernel settings for the following calls, every point of both used. The
+  // clouds must stay alive and unchanged until the next setProblem: a device backend copies
+  // them to the device here, and only here.
   virtual void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                           const CvoParams& params) = 0;
+  // From the next call on, only `subsets` of the clouds of the last setProblem.
+  virtual void useSubsets(const CloudSubsets& subsets) = 0;
   // Sums over the retained pairs (x_i, T z_j) at lengthscale `ell`.
   virtual kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) = 0;
   // The same sums at a pose that the following calls will not come back near (an indicator at

@@ -18,6 +18,7 @@ class StuckBackend : public RegistrationBackend {
   std::string name() const override { return inner_->name() + " (stuck, test)"; }
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
+  void useSubsets(const CloudSubsets& subsets) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
   kernels::CurvatureSums curvature(const Eigen::Isometry3d& T, double ell) override;

@@ -15,7 +15,7 @@ namespace cvo {
 
 class TimedBackend : public RegistrationBackend {
  public:
-  enum Call { kSetProblem, kMoments, kOneOffMoments, kTaylor, kCurvature, kCallKinds };
+  enum Call { kSetProblem, kUseSubsets, kMoments, kOneOffMoments, kTaylor, kCurvature, kCallKinds };
   struct Tally {
     long calls = 0;
     double ms = 0.0;
@@ -26,6 +26,7 @@ class TimedBackend : public RegistrationBackend {
   std::string name() const override { return inner_->name(); }
   void setProblem(const LabeledCloud& target, const LabeledCloud& source,
                   const CvoParams& params) override;
+  void useSubsets(const CloudSubsets& subsets) override;
   kernels::MomentSums moments(const Eigen::Isometry3d& T, double ell) override;
   kernels::MomentSums oneOffMoments(const Eigen::Isometry3d& T, double ell) override;
   kernels::TaylorSums taylor(const Eigen::Isometry3d& T, const Vector6d& xi, double ell) override;
