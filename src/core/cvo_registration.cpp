@@ -95,12 +95,13 @@ RegistrationResult CvoRegistration::align(const LabeledCloud& target, const Labe
   }
   target_ = &target;
   source_ = &source;
+  first_weight_at_final_ = -1.0;
+  auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
+  // Each registration tries the GPU again: before the problem is set, so that the GPU has it.
+  if (failover) failover->restore();
   // The whole clouds once (a device copies them here); each level then names its subsets.
   backend_->setProblem(target, source, params_);
   subsets_ = CloudSubsets{};
-  first_weight_at_final_ = -1.0;
-  auto* failover = dynamic_cast<FailoverBackend*>(backend_.get());
-  if (failover) failover->restore();  // each registration tries the GPU again
   RegistrationResult result;
   RegistrationReport& report = result.report;
   report.backend = backend_->name();

@@ -509,6 +509,29 @@ TEST(CvoRegistration, ABackendFailureMidRunFallsBackToTheCpuWithTheSameAnswer) {
   EXPECT_LT((got.transform.matrix() - expected.transform.matrix()).norm(), params.eps_2);
 }
 
+// The registration after one that fell back: the GPU is tried again, so it must be given the new
+// clouds before anything is asked of it (it was given the old ones, since freed, last: ASan in
+// scripts/test_sanitizers.sh reads that as a use after free).
+TEST(CvoRegistration, TheRegistrationAfterAFallbackGivesTheGpuItsClouds) {
+  CvoParams params = syntheticParams(true);
+  CvoRegistration flaky(
+      params, std::make_unique<cvo::FailoverBackend>(std::make_unique<cvo::FaultInjectionBackend>(
+                                                         std::make_unique<cvo::CpuBackend>(1), 5),
+                                                     std::make_unique<cvo::CpuBackend>(1)));
+  {
+    const auto [target, source] = movedRoomPair(80);
+    const auto first = flaky.align(target, source, Eigen::Isometry3d::Identity(), true);
+    EXPECT_NE(first.report.warning.find("injected backend fault"), std::string::npos);
+  }
+  const auto [target, source] = movedRoomPair(60);
+  CvoRegistration plain(params, std::make_unique<cvo::CpuBackend>(1));
+  const auto expected = plain.align(target, source, Eigen::Isometry3d::Identity(), true);
+  const auto got = flaky.align(target, source, Eigen::Isometry3d::Identity(), true);
+  EXPECT_TRUE(got.report.converged);
+  EXPECT_EQ(got.report.backend, "cpu (fallback: cpu (fault injection) failed)");
+  EXPECT_LT((got.transform.matrix() - expected.transform.matrix()).norm(), params.eps_2);
+}
+
 TEST(CvoRegistration, ATimedBackendGivesTheSameAnswerAndCountsEveryCall) {
   // The benchmark's --time-calls wraps the backend: the registration must not notice, and the
   // tally must hold every call it made (coarse levels on subsampled clouds, a curvature pass).
