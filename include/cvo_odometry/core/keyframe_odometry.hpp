@@ -147,6 +147,9 @@ class KeyframeOdometry {
     double track_rotation_gap_deg = -1.0;
     std::string problems;
     bool good = false;
+    // The share of the cloud's points left out as not following the tracks' motion (an attempt
+    // with the consistent points only), else -1.
+    double left_out_share = -1.0;
   };
   struct Guess {
     GuessKind kind;
@@ -176,6 +179,14 @@ class KeyframeOdometry {
   // The object's region left out of the reference too, where it is the frame the prior's
   // tracks start from and still whole.
   void leaveOutObjectFromReference(const MotionPrior& prior, const MotionSplit& split);
+  // The reference's and the cloud's points that the tracks' motion (frame.prior, which must be
+  // confident) puts near a point of the other, and a registration of those alone from that
+  // motion. Points that do not follow the scene's motion (a moving object without corners of its
+  // own: its leading and trailing edges, and all of it once it moved off its place in the
+  // keyframe) are left out. Null when too few are left, or when what is left out may be the
+  // scene (not nearer than what is kept, the tracks' motion not told from another's).
+  std::optional<Attempt> attemptWithConsistentPoints(const LabeledCloud& cloud,
+                                                     const OdometryFrame& frame, double dt);
   // The prior's second motion checked and, when it is an object moving on its own, the scene's
   // motion made the prior's first and the object's region left out of the frame's cloud. Why the
   // frame cannot be trusted (which motion the scene follows is unknown), or empty.
