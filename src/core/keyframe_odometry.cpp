@@ -262,23 +262,21 @@ float medianOf(std::vector<float>& values) {
   return values[values.size() / 2];
 }
 
+// The depths of the kept and the left-out points go to `kept_depths` and `left_depths` when
+// they are given.
 LabeledCloud consistentPoints(const LabeledCloud& cloud, const VoxelGrid& other,
-                              const Eigen::Isometry3f& T, std::vector<float>* kept_depths,
-                              std::vector<float>* left_depths) {
+                              const Eigen::Isometry3f& T, std::vector<float>* kept_depths = nullptr,
+                              std::vector<float>* left_depths = nullptr) {
   return cloud.without(
       [&](const Eigen::Vector3f& point) {
         const Eigen::Vector3f moved = T * point;
         const float radius = static_cast<float>(
             std::max(kConsistentMinDistance, kConsistentDepthShare * std::abs(point.z())));
         bool near = false;
-        other.forEachRange(moved.data(), radius, [&](std::uint32_t begin, std::uint32_t end) {
-          for (std::uint32_t k = begin; k < end && !near; ++k) {
-            const float dx = other.sortedX()[k] - moved.x(), dy = other.sortedY()[k] - moved.y(),
-                        dz = other.sortedZ()[k] - moved.z();
-            near = dx * dx + dy * dy + dz * dz <= radius * radius;
-          }
-        });
-        (near ? kept_depths : left_depths)->push_back(std::abs(point.z()));
+        other.forEachWithin(moved.data(), radius, [&](std::uint32_t, float) { near = true; });
+        if (std::vector<float>* depths = near ? kept_depths : left_depths) {
+          depths->push_back(std::abs(point.z()));
+        }
         return !near;
       },
       nullptr);
@@ -297,18 +295,17 @@ float consistencyCell(const LabeledCloud& cloud) {
 
 std::optional<KeyframeOdometry::Attempt> KeyframeOdometry::attemptWithConsistentPoints(
     const LabeledCloud& cloud, const OdometryFrame& frame, double dt) {
-  const Eigen::Isometry3d motion =
-      lie::orthonormalized(reference_pose_.inverse() * prior_frame_pose_ * frame.prior->motion);
+  const Eigen::Isometry3d motion = priorMotionFromReference(*frame.prior);
   const Eigen::Isometry3f reference_from_current = motion.cast<float>();
   VoxelGrid reference_grid, cloud_grid;
   reference_grid.build(reference_->positionData().data(), reference_->size(),
                        consistencyCell(*reference_));
   cloud_grid.build(cloud.positionData().data(), cloud.size(), consistencyCell(cloud));
-  std::vector<float> kept_depths, left_depths, unused;
+  std::vector<float> kept_depths, left_depths;
   LabeledCloud kept_cloud =
       consistentPoints(cloud, reference_grid, reference_from_current, &kept_depths, &left_depths);
-  auto kept_reference = std::make_shared<const LabeledCloud>(consistentPoints(
-      *reference_, cloud_grid, reference_from_current.inverse(), &unused, &unused));
+  auto kept_reference = std::make_shared<const LabeledCloud>(
+      consistentPoints(*reference_, cloud_grid, reference_from_current.inverse()));
   const auto minimum = static_cast<std::size_t>(params().min_tracking_points);
   if (kept_cloud.size() < minimum || kept_reference->size() < minimum ||
       kept_cloud.size() < kMinSceneShare * cloud.size()) {
@@ -320,18 +317,29 @@ std::optional<KeyframeOdometry::Attempt> KeyframeOdometry::attemptWithConsistent
   // keep.
   const bool scene_known = split_ && split_->scene != SceneMotion::kUndecided;
   if (!scene_known && medianOf(left_depths) >= medianOf(kept_depths)) return std::nullopt;
-  const std::shared_ptr<const LabeledCloud> keyframe = reference_;
-  const auto keyframe_self = reference_self_;
-  const auto cloud_self = source_self_;
+  // attempt() registers to reference_ and caches both clouds' self products: the kept clouds
+  // stand in for this attempt only, also when it throws (a device failure without fallback).
+  struct Restore {
+    KeyframeOdometry& o;
+    std::shared_ptr<const LabeledCloud> reference;
+    decltype(reference_self_) reference_self;
+    decltype(source_self_) source_self;
+    ~Restore() {
+      o.reference_ = std::move(reference);
+      o.reference_self_ = reference_self;
+      o.source_self_ = source_self;
+    }
+  } restore{*this, reference_, reference_self_, source_self_};
   reference_ = kept_reference;
   reference_self_.reset();
   source_self_.reset();
   Attempt a = attempt(kept_cloud, Guess{GuessKind::kFeatures, motion}, frame, dt);
   a.left_out_share = 1.0 - static_cast<double>(kept_cloud.size()) / cloud.size();
-  reference_ = keyframe;
-  reference_self_ = keyframe_self;
-  source_self_ = cloud_self;
   return a;
+}
+
+Eigen::Isometry3d KeyframeOdometry::priorMotionFromReference(const MotionPrior& prior) const {
+  return lie::orthonormalized(reference_pose_.inverse() * prior_frame_pose_ * prior.motion);
 }
 
 void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval,
@@ -340,11 +348,8 @@ void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval
   const std::optional<Eigen::Isometry3d> velocity = constantVelocityMotion(interval);
   const Guess still{GuessKind::kIdentity, stillMotion()};
   const bool confident = priorConfident(frame.prior);
-  // The prior moves the camera from the pose of the frame its tracks start from.
-  const Guess prior{GuessKind::kFeatures,
-                    confident ? lie::orthonormalized(reference_pose_.inverse() * prior_frame_pose_ *
-                                                     frame.prior->motion)
-                              : Eigen::Isometry3d::Identity()};
+  const Guess prior{GuessKind::kFeatures, confident ? priorMotionFromReference(*frame.prior)
+                                                    : Eigen::Isometry3d::Identity()};
   const Guess constant{GuessKind::kConstantVelocity,
                        velocity ? *velocity : Eigen::Isometry3d::Identity()};
   switch (p.initial_guess) {

@@ -168,6 +168,9 @@ class KeyframeOdometry {
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
                      std::vector<Guess>* retries) const;
   bool priorConfident(const std::optional<MotionPrior>& prior) const;
+  // The prior's motion as a step from the reference (reference <- current): it moves the camera
+  // from the pose of the frame its tracks start from.
+  Eigen::Isometry3d priorMotionFromReference(const MotionPrior& prior) const;
   // The prior's second motion is an object moving on its own: min_prior_inliers tracks, and
   // its motion moves the tracks at least moving_min_px from where the first puts them.
   bool separateSecondMotion(const std::optional<MotionPrior>& prior) const;
