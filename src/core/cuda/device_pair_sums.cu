@@ -309,7 +309,6 @@ struct DevicePairSums<System>::Impl {
   unsigned target_stride = 1, source_stride = 1;
   unsigned long long source_thinned = 0;
   int active_source = 0;  // the source subset's points
-  int classes = 0;
   kernels::KernelConstants constants{};
   double cutoff2 = 0.0;
   Grid* grid = nullptr;  // the grid of the last evaluation
@@ -324,11 +323,11 @@ struct DevicePairSums<System>::Impl {
 
   // Makes the target with these arrays the one in use: a kept one when its bits are the same,
   // else uploaded in place of the least recently used.
-  void useTarget(const float* const* host, const std::size_t* sizes, int count, int classes_,
+  void useTarget(const float* const* host, const std::size_t* sizes, int count, int classes,
                  bool has_color) {
     for (int t = 0; t < kTargetsKept; ++t) {
       Target& kept = targets[t];
-      if (!kept.valid || kept.count != count || kept.classes != classes_ ||
+      if (!kept.valid || kept.count != count || kept.classes != classes ||
           kept.has_color != has_color) {
         continue;
       }
@@ -365,7 +364,7 @@ struct DevicePairSums<System>::Impl {
     for (int a = 0; a < 3; ++a)
       slot.host[a].assign(host[a], host[a] + sizes[a]);
     slot.count = count;
-    slot.classes = classes_;
+    slot.classes = classes;
     slot.has_color = has_color;
     slot.valid = true;
     slot.last_used = ++clock;
@@ -503,7 +502,6 @@ void DevicePairSums<System>::setCloud(bool target, const float* positions, const
       ++d.work.uploads;
       d.source_count = count;
     }
-    d.classes = classes;
     // Every point of both, until useSubsets says otherwise.
     d.target_stride = d.source_stride = 1;
     d.source_thinned = 0;
