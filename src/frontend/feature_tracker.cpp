@@ -62,6 +62,14 @@ std::optional<Eigen::Isometry3d> solvePnp(const std::vector<cv::Point3f>& points
   return current_from_previous;
 }
 
+// A track off the first motion has slipped on a repeating texture when KLT, started where that
+// motion puts it, settles within its inlier distance with a patch error at most this share of
+// its own track's, plus this slack (grey levels).
+constexpr float kSlippedErrorShare = 1.5f;
+constexpr float kSlippedErrorSlack = 2.0f;
+// A second motion at least this share of whose tracks slipped is the texture's, not an object's.
+constexpr double kSlippedShare = 0.5;
+
 // The previous frame's point X, moved by current <- previous, lands within `threshold` of the
 // ray x where the current image sees it.
 bool reprojects(const Eigen::Isometry3d& current_from_previous, const Eigen::Vector3d& X,
@@ -271,6 +279,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   const std::vector<cv::Point2f>& seen = anchor_.pixels;
   cv::calcOpticalFlowPyrLK(anchor_.pyramid, current, seen, forward, ok_forward, errors, window,
                            options_.levels, stop);
+  const std::vector<float> forward_errors = errors;
   backward = seen;
   // The check starts at home (the initial flow): a right track has nothing to search for, so
   // one level above the image will do; a wrong one still moves away or fails, and RANSAC's
@@ -280,7 +289,8 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
                            std::min(options_.levels, kBackwardLevels), stop,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   std::vector<cv::Point3f> points;
-  std::vector<cv::Point2f> pixels;
+  std::vector<cv::Point2f> pixels, from_pixels;  // where tracks are now, and were
+  std::vector<float> track_errors;
   std::vector<bool> on_object;  // seen on the moving object in the previous frame
   for (std::size_t k = 0; k < seen.size(); ++k) {
     const cv::Point2f& p = forward[k];
@@ -296,6 +306,8 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
     }
     points.push_back(anchor_.points[k]);
     pixels.push_back(p);
+    from_pixels.push_back(seen[k]);
+    track_errors.push_back(forward_errors[k]);
     on_object.push_back(anchor_.moving_region &&
                         anchor_.moving_region->contains(seen[k].x, seen[k].y));
   }
@@ -347,6 +359,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   prior.tracked_observations.reserve(points.size());
   std::vector<cv::Point3f> rest_points;
   std::vector<cv::Point2f> rest_observed, rest_pixels;
+  std::vector<std::size_t> rest_index;  // into points
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
     const Eigen::Vector2d x(observed[k].x, observed[k].y);
@@ -357,6 +370,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
       rest_points.push_back(points[k]);
       rest_observed.push_back(observed[k]);
       rest_pixels.push_back(pixels[k]);
+      rest_index.push_back(k);
       continue;
     }
     prior.points.push_back(X);
@@ -372,6 +386,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   const std::optional<Eigen::Isometry3d> second = solvePnp(rest_points, rest_observed, threshold);
   if (!second || !second->matrix().allFinite()) return prior;
   MotionPrior::SecondMotion& out = prior.second;
+  std::vector<bool> on_second(points.size(), false);
   for (std::size_t k = 0; k < rest_points.size(); ++k) {
     const Eigen::Vector3d X(rest_points[k].x, rest_points[k].y, rest_points[k].z);
     if (!reprojects(*second, X, Eigen::Vector2d(rest_observed[k].x, rest_observed[k].y),
@@ -379,11 +394,60 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
       continue;
     }
     out.pixels.emplace_back(rest_pixels[k].x, rest_pixels[k].y);
+    on_second[rest_index[k]] = true;
   }
   out.inliers = static_cast<int>(out.pixels.size());
   out.solved = out.pixels.size() >= kMinPnpInliers;
+  if (out.solved) {
+    const std::vector<bool> slipped = slippedTracks(current, points, from_pixels, track_errors,
+                                                    on_second, current_from_previous, prior.camera);
+    prior.slipped = static_cast<int>(std::count(slipped.begin(), slipped.end(), true));
+    // Mostly slipped tracks: a repeating texture, not an object.
+    if (prior.slipped >= kSlippedShare * out.inliers) out.solved = false;
+  }
   out.motion = second->inverse();
   return prior;
+}
+
+std::vector<bool> FeatureTracker::slippedTracks(const std::vector<cv::Mat>& current,
+                                                const std::vector<cv::Point3f>& points,
+                                                const std::vector<cv::Point2f>& from_pixels,
+                                                const std::vector<float>& track_errors,
+                                                const std::vector<bool>& which,
+                                                const Eigen::Isometry3d& current_from_previous,
+                                                const std::optional<CameraModel>& camera) const {
+  // On a repeating texture (a keyboard's keys, tiles, a fence) KLT can slip by one period, both
+  // ways alike, and the slipped tracks agree on a motion of their own: a second motion where
+  // nothing moves. Such a track, started again where the first motion puts it, settles there.
+  std::vector<bool> slipped(points.size(), false);
+  if (!camera) return slipped;
+  std::vector<std::size_t> tried;
+  std::vector<cv::Point2f> starts, ends;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (!which[k]) continue;
+    const Eigen::Vector3d p =
+        current_from_previous * Eigen::Vector3d(points[k].x, points[k].y, points[k].z);
+    if (!(p.z() > 1e-6)) continue;
+    const Eigen::Vector2d pixel = camera->project(p);
+    tried.push_back(k);
+    starts.push_back(from_pixels[k]);
+    ends.emplace_back(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()));
+  }
+  if (tried.empty()) return slipped;
+  const std::vector<cv::Point2f> predicted = ends;
+  std::vector<unsigned char> ok;
+  std::vector<float> errors;
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  // One level: the search stays near where the first motion puts the track.
+  cv::calcOpticalFlowPyrLK(anchor_.pyramid, current, starts, ends, ok, errors,
+                           cv::Size(options_.window, options_.window), 0, stop,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t i = 0; i < tried.size(); ++i) {
+    const std::size_t k = tried[i];
+    if (!ok[i] || cv::norm(ends[i] - predicted[i]) > options_.ransac_px) continue;
+    slipped[k] = errors[i] <= kSlippedErrorShare * track_errors[k] + kSlippedErrorSlack;
+  }
+  return slipped;
 }
 
 }  // namespace cvo

@@ -190,7 +190,12 @@ int main(int argc, char** argv) {
         if (update.second_motion_tracks > 0) {
           std::cerr << ", second motion " << update.second_motion_tracks << " tracks"
                     << (update.second_motion_separate ? " (its own: " : " (")
-                    << std::setprecision(1) << 100.0 * update.left_out_share << " % left out)";
+                    << std::setprecision(1) << 100.0 * update.left_out_share << " % left out";
+          // Tracks that settle where the first motion puts them too: a repeating texture.
+          if (result.prior && result.prior->slipped > 0) {
+            std::cerr << "; " << result.prior->slipped << " slipped";
+          }
+          std::cerr << ")";
           if (!update.motion_split.empty()) std::cerr << " [" << update.motion_split << "]";
         }
         if (update.state != cvo::TrackingState::kTracking) {

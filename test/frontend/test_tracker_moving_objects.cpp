@@ -168,14 +168,9 @@ double shareOnBoard(const Pixels& pixels, const cv::Mat& mask) {
   return static_cast<double>(on) / static_cast<double>(pixels.size());
 }
 
-// TUM frames 0..last with a blocks board composited moving across at about 8 px a frame (0.3 m/s
-// across at 0.65 m, and away at 0.2 m/s, as the bench's person case); calls `each` with every
-// frame (colour, grey and depth with the board) and the board's mask.
-void withMovingBoard(double area, std::size_t last,
-                     const std::function<void(std::size_t, const Frame&, const cv::Mat&)>& each) {
-  const cvo::TumSequence sequence(kTum);
-  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
-  const cvo::Trajectory truth = cvo::readTumTrajectory(kTum + "/groundtruth.txt");
+// A blocks board of `area` of the image moving across at about 8 px a frame (0.3 m/s across at
+// 0.65 m, and away at 0.2 m/s, as the bench's person case).
+cvo::MovingObjectSpec boardSpec(double area) {
   cvo::MovingObjectSpec spec;
   spec.area = area;
   spec.depth = 0.65;
@@ -183,6 +178,16 @@ void withMovingBoard(double area, std::size_t last,
   spec.start_v = 0.5;
   spec.velocity = Eigen::Vector3d(0.3, 0.0, 0.2);
   spec.texture = cvo::ObjectTexture::kBlocks;
+  return spec;
+}
+
+// TUM frames 0..last with the board of `spec` composited; calls `each` with every frame
+// (colour, grey and depth with the board) and the board's mask.
+void withMovingBoard(const cvo::MovingObjectSpec& spec, std::size_t last,
+                     const std::function<void(std::size_t, const Frame&, const cv::Mat&)>& each) {
+  const cvo::TumSequence sequence(kTum);
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  const cvo::Trajectory truth = cvo::readTumTrajectory(kTum + "/groundtruth.txt");
   const Frame first = loadFrame(sequence, 0);
   Eigen::Isometry3d world_from_first;
   ASSERT_TRUE(truth.interpolate(first.stamp, 0.05, &world_from_first));
@@ -199,7 +204,8 @@ void withMovingBoard(double area, std::size_t last,
     cv::cvtColor(frame.colour, frame.grey, cv::COLOR_BGR2GRAY);
     const cv::Moments m = cv::moments(mask, true);
     const double u = m.m10 / m.m00;
-    if (last_u >= 0.0) {
+    // Over the first frames; later the camera's own motion adds to the board's.
+    if (last_u >= 0.0 && k <= 8) {
       EXPECT_GT(u - last_u, 5.0) << "frame " << k << ": the board moves ~8 px a frame";
       EXPECT_LT(u - last_u, 13.0) << "frame " << k;
     }
@@ -215,7 +221,7 @@ TEST(TrackerMovingObjects, MovingBoardIsFoundAsASecondMotion) {
   const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
   cvo::FeatureTracker tracker({});
   int solved = 0, frames = 0;
-  withMovingBoard(0.12, 8, [&](std::size_t k, const Frame& frame, const cv::Mat& mask) {
+  withMovingBoard(boardSpec(0.12), 8, [&](std::size_t k, const Frame& frame, const cv::Mat& mask) {
     const cvo::MotionPrior prior =
         tracker.track(frame.grey, frame.depth, K, 0, cv::Mat(), frame.stamp);
     if (k == 0) return;
@@ -243,7 +249,7 @@ TEST(TrackerMovingObjects, LargeBoardIsToldFromTheSceneAndTaggedForTheNextFrame)
   const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
   const cvo::CvoParams params;
   cvo::FeatureTracker tracker({});
-  withMovingBoard(0.33, 8, [&](std::size_t k, const Frame& frame, const cv::Mat& mask) {
+  withMovingBoard(boardSpec(0.33), 8, [&](std::size_t k, const Frame& frame, const cv::Mat& mask) {
     const cvo::MotionPrior prior =
         tracker.track(frame.grey, frame.depth, K, 0, cv::Mat(), frame.stamp);
     if (k == 0) return;
@@ -269,6 +275,39 @@ TEST(TrackerMovingObjects, LargeBoardIsToldFromTheSceneAndTaggedForTheNextFrame)
     region->closeGaps(2.0 * params.moving_region_px);
     tracker.frameJudged(true, region);
   });
+}
+
+// Proves, with a checkerboard of a third of the image moving across (the bench's checker case)
+// and its mask given as the excluded pixels (grown as the pipeline grows labels): nothing left
+// in view moves, and no frame shows a second motion the odometry would take for an object
+// (moving_min_px apart, min_prior_inliers tracks). The keyboard's keys repeat every ~15 px:
+// tracks there slip by a key, both ways alike, and agree on a motion of their own (frames 28
+// and 29 lost with "tracks split between two motions" when they counted); some frames find
+// such slipped tracks.
+TEST(TrackerMovingObjects, TracksSlippedOnARepeatingTextureAreNoSecondMotion) {
+  const cvo::PinholeIntrinsics K = cvo::tumIntrinsics("fr1");
+  const cvo::CvoParams params;
+  cvo::MovingObjectSpec spec = boardSpec(0.33);
+  spec.velocity = Eigen::Vector3d(0.25, 0.0, 0.2);
+  spec.texture = cvo::ObjectTexture::kChecker;
+  cvo::FeatureTracker tracker({});
+  int slipped_frames = 0;
+  withMovingBoard(spec, 30, [&](std::size_t k, const Frame& frame, const cv::Mat& mask) {
+    cv::Mat excluded;
+    cv::dilate(mask, excluded, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(17, 17)));
+    const cvo::MotionPrior prior =
+        tracker.track(frame.grey, frame.depth, K, 0, excluded, frame.stamp);
+    tracker.frameJudged(true, nullptr);
+    if (k == 0) return;
+    ASSERT_TRUE(prior.solved) << "frame " << k << ": " << prior.problem;
+    slipped_frames += prior.slipped > 0;
+    if (!prior.second.solved || prior.second.inliers < params.min_prior_inliers) return;
+    const double apart = cvo::motionsApartPx(prior, prior.motion, prior.second.motion);
+    std::cout << "frame " << k << ": second motion " << prior.second.inliers << " tracks, " << apart
+              << " px apart; " << prior.slipped << " slipped\n";
+    EXPECT_LT(apart, params.moving_min_px) << "frame " << k;
+  });
+  EXPECT_GE(slipped_frames, 3);
 }
 
 }  // namespace

@@ -23,6 +23,9 @@ struct MotionPrior {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current (camera)
   int tracks = 0;   // previous frame corners with depth tracked into the current image
   int inliers = 0;  // tracks consistent with `motion`
+  // Of the second motion's tracks, those that, started again where `motion` puts them, settle
+  // there as well (a repeating texture); a second motion of mostly such tracks is not solved.
+  int slipped = 0;
   double inlier_ratio = 0.0;
   // The inlier tracks: the previous frame's points (its camera frame) and where the current
   // image sees them (normalised, undistorted image coordinates x/z, y/z).

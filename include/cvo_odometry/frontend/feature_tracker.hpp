@@ -105,6 +105,16 @@ class FeatureTracker {
                            const cv::Mat& excluded, double stamp);
   MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Size& size,
                     const PinholeIntrinsics& intrinsics, const cv::Mat& excluded) const;
+  // Per track of `which` (`points` seen at `from_pixels`, with KLT's `track_errors`): true where
+  // KLT, started where `current_from_previous` puts it, settles there too with a patch about as
+  // alike as its own track's (a repeating texture).
+  std::vector<bool> slippedTracks(const std::vector<cv::Mat>& current,
+                                  const std::vector<cv::Point3f>& points,
+                                  const std::vector<cv::Point2f>& from_pixels,
+                                  const std::vector<float>& track_errors,
+                                  const std::vector<bool>& which,
+                                  const Eigen::Isometry3d& current_from_previous,
+                                  const std::optional<CameraModel>& camera) const;
 
   FeatureTrackerOptions options_;
   MinEigenCorners corners_;         // used by seed() only
