@@ -220,6 +220,7 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
     return result;
   }
   stale_.accept();
+  input.moving_classes_left_out = !images.excluded.empty();
   if (!settings_.features.enabled || images.grey.empty()) {
     tracker_->reset();  // the prior relates this frame and the next only: none without images
   } else {

@@ -48,6 +48,8 @@ struct OdometryFrame {
   std::shared_ptr<const LabeledCloud> cloud;  // null: the front end found nothing to track
   std::string why_no_cloud;
   std::optional<MotionPrior> prior;  // previous frame <- current from feature tracks
+  // The segmentation left pixels of moving classes out of this frame (cloud, tracks, images).
+  bool moving_classes_left_out = false;
   // base <- camera; taken at the first frame of a trajectory (after a reset).
   Eigen::Isometry3d base_from_camera = Eigen::Isometry3d::Identity();
 };
