@@ -20,6 +20,9 @@ constexpr double kNeighbourShare = 0.075;
 constexpr double kFrontMargin = 0.05;
 constexpr double kFrontShare = 0.75;
 constexpr int kMinNeighbourPairs = 10;
+// A second motion at least this share of whose tracks start on the object of the frame they
+// start from is that object's.
+constexpr double kKnownObjectShare = 0.5;
 
 // Reprojection error (px) of the prior's tracked point k under motion (previous <- current)
 // given as current <- previous.
@@ -145,6 +148,19 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
     why << ": at similar depths, the scene follows the motion with more tracks and nearer the "
            "constant-velocity prediction, the "
         << name(more);
+    split.why = why.str();
+    return split;
+  }
+  if (prior.second.known_object > 0 &&
+      prior.second.known_object >= kKnownObjectShare * prior.second.inliers &&
+      nearer_prediction != SceneMotion::kSecond) {
+    // The tracks alone cannot tell, but the last trusted frame did: most of the second motion's
+    // tracks start on the object found there (unless the prediction points at its motion).
+    split.scene = SceneMotion::kFirst;
+    why << ": at similar depths, the second motion's tracks are the object's of the last trusted "
+           "frame ("
+        << prior.second.known_object << " of " << prior.second.inliers
+        << "): the scene follows the first motion";
     split.why = why.str();
     return split;
   }

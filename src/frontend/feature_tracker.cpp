@@ -395,6 +395,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
     }
     out.pixels.emplace_back(rest_pixels[k].x, rest_pixels[k].y);
     on_second[rest_index[k]] = true;
+    if (separate && on_object[rest_index[k]]) ++out.known_object;
   }
   out.inliers = static_cast<int>(out.pixels.size());
   out.solved = out.pixels.size() >= kMinPnpInliers;

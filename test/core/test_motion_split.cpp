@@ -207,6 +207,23 @@ TEST(MotionSplit, LopsidedSplitAtSimilarDepthsPicksTheLarger) {
   EXPECT_EQ(e.scene, cvo::SceneMotion::kUndecided) << e.why;
 }
 
+// Proves: a balanced split at similar depths, undecided on the tracks alone, follows the first
+// motion when most of the second motion's tracks start on the object the last trusted frame
+// found (MotionPrior::SecondMotion::known_object), not when fewer than half do, and not when the
+// constant-velocity prediction points at the second motion.
+TEST(MotionSplit, TheObjectKnownFromTheLastFrameSettlesABalancedSplit) {
+  Scene balanced = similarDepths(60, 50);
+  balanced.prior.second.inliers = 50;
+  balanced.prior.second.known_object = 24;
+  EXPECT_EQ(split(balanced.prior).scene, cvo::SceneMotion::kUndecided);
+  balanced.prior.second.known_object = 40;
+  const cvo::MotionSplit known = split(balanced.prior);
+  EXPECT_EQ(known.scene, cvo::SceneMotion::kFirst) << known.why;
+  EXPECT_NE(known.why.find("object's of the last trusted frame"), std::string::npos) << known.why;
+  const cvo::MotionSplit against = split(balanced.prior, balanced.prior.second.motion);
+  EXPECT_EQ(against.scene, cvo::SceneMotion::kUndecided) << against.why;
+}
+
 // Proves: sceneFirst puts the scene's motion first (swapping when the scene follows the second)
 // and gives each motion its own tracks only: the inlier set is the scene's tracks, the second
 // motion's pixels the object's, no track in both.

@@ -267,6 +267,8 @@ TEST(TrackerMovingObjects, LargeBoardIsToldFromTheSceneAndTaggedForTheNextFrame)
     if (k >= 2) {
       EXPECT_LT(raw_first_on, 0.2) << "frame " << k << ": the tagged corners kept the first "
                                    << "motion the scene's";
+      // ... and the second motion's tracks are known as the object's (splitMotions reads it).
+      EXPECT_GE(prior.second.known_object, prior.second.inliers / 2) << "frame " << k;
     }
     // As the odometry does: discs around the board's tracks, gaps closed.
     auto region = std::make_shared<cvo::PixelRegion>(frame.grey.cols, frame.grey.rows);

@@ -49,6 +49,9 @@ struct MotionPrior {
     bool solved = false;
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
     int inliers = 0;
+    // Of the inliers, those that start in the object's region of the frame the tracks start
+    // from (the first motion is then solved from the other tracks).
+    int known_object = 0;
     std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> pixels;
   } second;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
