@@ -23,6 +23,9 @@ constexpr double kUnknownVariance = 1e6;
 // An object seen moving within this long (s) may still be in view: every registration needs
 // the tracks' judgement meanwhile.
 constexpr double kMovingMemorySeconds = 2.0;
+// With the moving classes left out, an unsettled split of motions less than this many times
+// moving_min_px apart is the still scene's own spread.
+constexpr double kSpreadApartFactor = 2.0;
 // A split leaves at least this share of the frame's points to the scene, or is not trusted.
 constexpr double kMinSceneShare = 0.3;
 
@@ -186,9 +189,15 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   // as the still scene's own spread (near and far tracks of an RGB-D camera, whose depth is older
   // than its colour, a few pixels apart), not as an object: the frame is registered whole and
   // judged by all its tracks. TUM with a board approaching, labelled (bench/dynamic_table.sh's
-  // "towards"): frames whose view the board halves split this way.
+  // "towards"): frames whose view the board halves split this way, 7.0 and 7.5 px apart. Motions
+  // further apart than twice moving_min_px are an object of a class not left out: lost, as
+  // without labels.
+  const bool scene_spread =
+      frame.moving_classes_left_out &&
+      motionsApartPx(*frame.prior, frame.prior->motion, frame.prior->second.motion) <
+          kSpreadApartFactor * params().moving_min_px;
   if (split_->scene == SceneMotion::kUndecided) {
-    if (frame.moving_classes_left_out) {
+    if (scene_spread) {
       split_.reset();
       return "";
     }
@@ -197,7 +206,7 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   MotionPrior scene = sceneFirst(*frame.prior, *split_);
   std::shared_ptr<const LabeledCloud> rest = withoutRegion(frame.cloud, scene, scene.second.pixels);
   if (frame.cloud && rest->size() < kMinSceneShare * frame.cloud->size()) {
-    if (frame.moving_classes_left_out) {
+    if (scene_spread) {
       split_.reset();
       return "";
     }
