@@ -78,7 +78,6 @@ KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
 
 void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   moving_seen_stamp_.reset();
-  unlabelled_object_stamp_.reset();
   reference_.reset();
   reference_guessed_ = false;
   last_good_.reset();
@@ -177,7 +176,6 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   split_.reset();
   if (!separateSecondMotion(frame.prior)) return "";
   moving_seen_stamp_ = frame.stamp;
-  if (!frame.moving_classes_left_out) unlabelled_object_stamp_ = frame.stamp;
   // The camera's last velocity predicts this step (previous <- current).
   std::optional<Eigen::Isometry3d> predicted;
   const double from =
@@ -775,16 +773,7 @@ void KeyframeOdometry::setReference(const std::shared_ptr<const LabeledCloud>& c
 
 bool KeyframeOdometry::wantsKeyframe(const OdometryUpdate& update) const {
   const CvoParams& p = params();
-  // While an object of its own motion moves in view unlabelled, the keyframe is the last trusted
-  // frame: an older one holds what the object covered and uncovered since, which neither the
-  // tracks' region nor the points that follow the tracks' motion keep out for long
-  // (bench/dynamic_table.sh's checker: 7 -> 35 of 36 frames tracked). With labels, or an object
-  // without tracks of its own, keyframes stay: each frame's registration to the last one
-  // costs more than the stale view does there (labelled person 3.14 -> 3.26 mm; plain 4.90 ->
-  // 5.55 mm).
-  const bool object_lately =
-      unlabelled_object_stamp_ && update.stamp - *unlabelled_object_stamp_ <= kMovingMemorySeconds;
-  return p.reference == ReferenceKind::kPreviousFrame || object_lately ||
+  return p.reference == ReferenceKind::kPreviousFrame ||
          update.state == TrackingState::kRecovered ||
          (reference_first_cosine_ &&
           update.cosine < p.keyframe_cosine_ratio * *reference_first_cosine_) ||

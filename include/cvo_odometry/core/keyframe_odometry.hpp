@@ -227,8 +227,6 @@ class KeyframeOdometry {
   // When something last moved in view: a second motion of its own among the tracks, or tracks
   // that refused a registration.
   std::optional<double> moving_seen_stamp_;
-  // When the tracks last showed an object's own motion in a frame the labels left whole.
-  std::optional<double> unlabelled_object_stamp_;
   std::optional<MotionSplit> split_;  // of the frame being processed, when it was split
   // start <- the frame the processed frame's prior starts from (valid while it has one).
   Eigen::Isometry3d prior_frame_pose_ = Eigen::Isometry3d::Identity();
