@@ -11,6 +11,7 @@
 #include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/pose_covariance.hpp"
 #include "cvo_odometry/core/registration_covariance.hpp"
+#include "cvo_odometry/core/robust_scale.hpp"
 #include "cvo_odometry/core/tracking_check.hpp"
 #include "cvo_odometry/core/voxel_grid.hpp"
 
@@ -279,18 +280,12 @@ namespace {
 constexpr double kConsistentMinDistance = 0.004;
 constexpr double kConsistentDepthShare = 0.01;
 
-// The median of `values` (0 when empty); reorders them.
-float medianOf(std::vector<float>& values) {
-  if (values.empty()) return 0.0f;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
 // The depths of the kept and the left-out points go to `kept_depths` and `left_depths` when
 // they are given.
 LabeledCloud consistentPoints(const LabeledCloud& cloud, const VoxelGrid& other,
-                              const Eigen::Isometry3f& T, std::vector<float>* kept_depths = nullptr,
-                              std::vector<float>* left_depths = nullptr) {
+                              const Eigen::Isometry3f& T,
+                              std::vector<double>* kept_depths = nullptr,
+                              std::vector<double>* left_depths = nullptr) {
   return cloud.without(
       [&](const Eigen::Vector3f& point) {
         const Eigen::Vector3f moved = T * point;
@@ -298,7 +293,7 @@ LabeledCloud consistentPoints(const LabeledCloud& cloud, const VoxelGrid& other,
             std::max(kConsistentMinDistance, kConsistentDepthShare * std::abs(point.z())));
         bool near = false;
         other.forEachWithin(moved.data(), radius, [&](std::uint32_t, float) { near = true; });
-        if (std::vector<float>* depths = near ? kept_depths : left_depths) {
+        if (std::vector<double>* depths = near ? kept_depths : left_depths) {
           depths->push_back(std::abs(point.z()));
         }
         return !near;
@@ -307,12 +302,13 @@ LabeledCloud consistentPoints(const LabeledCloud& cloud, const VoxelGrid& other,
 }
 
 float consistencyCell(const LabeledCloud& cloud) {
-  std::vector<float> depths;
+  if (cloud.empty()) return static_cast<float>(kConsistentMinDistance);
+  std::vector<double> depths;
   depths.reserve(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i)
     depths.push_back(std::abs(cloud.position(i).z()));
   return static_cast<float>(
-      std::max(kConsistentMinDistance, kConsistentDepthShare * medianOf(depths)));
+      std::max(kConsistentMinDistance, kConsistentDepthShare * medianInPlace(depths)));
 }
 
 }  // namespace
@@ -325,7 +321,7 @@ std::optional<KeyframeOdometry::Attempt> KeyframeOdometry::attemptWithConsistent
   reference_grid.build(reference_->positionData().data(), reference_->size(),
                        consistencyCell(*reference_));
   cloud_grid.build(cloud.positionData().data(), cloud.size(), consistencyCell(cloud));
-  std::vector<float> kept_depths, left_depths;
+  std::vector<double> kept_depths, left_depths;
   LabeledCloud kept_cloud =
       consistentPoints(cloud, reference_grid, reference_from_current, &kept_depths, &left_depths);
   auto kept_reference = std::make_shared<const LabeledCloud>(
@@ -340,7 +336,11 @@ std::optional<KeyframeOdometry::Attempt> KeyframeOdometry::attemptWithConsistent
   // object passes in front of the scene: what they leave out must then be nearer than what they
   // keep.
   const bool scene_known = split_ && split_->scene != SceneMotion::kUndecided;
-  if (!scene_known && medianOf(left_depths) >= medianOf(kept_depths)) return std::nullopt;
+  // (kept_depths holds at least min_tracking_points depths; left_depths may hold none.)
+  if (!scene_known && !left_depths.empty() &&
+      medianInPlace(left_depths) >= medianInPlace(kept_depths)) {
+    return std::nullopt;
+  }
   // attempt() registers to reference_ and caches both clouds' self products: the kept clouds
   // stand in for this attempt only, also when it throws (a device failure without fallback).
   struct Restore {

@@ -279,14 +279,13 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   const std::vector<cv::Point2f>& seen = anchor_.pixels;
   cv::calcOpticalFlowPyrLK(anchor_.pyramid, current, seen, forward, ok_forward, errors, window,
                            options_.levels, stop);
-  const std::vector<float> forward_errors = errors;
   backward = seen;
   // The check starts at home (the initial flow): a right track has nothing to search for, so
   // one level above the image will do; a wrong one still moves away or fails, and RANSAC's
   // inliers judge what passes. 0.4x the cost of all levels (TUM 2.1 -> 0.9 ms, KITTI 3.8 ->
   // 1.4 ms a frame), the prior alone as accurate (README "Large motions").
-  cv::calcOpticalFlowPyrLK(current, anchor_.pyramid, forward, backward, ok_backward, errors, window,
-                           std::min(options_.levels, kBackwardLevels), stop,
+  cv::calcOpticalFlowPyrLK(current, anchor_.pyramid, forward, backward, ok_backward, cv::noArray(),
+                           window, std::min(options_.levels, kBackwardLevels), stop,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
   std::vector<cv::Point3f> points;
   std::vector<cv::Point2f> pixels, from_pixels;  // where tracks are now, and were
@@ -307,7 +306,7 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
     points.push_back(anchor_.points[k]);
     pixels.push_back(p);
     from_pixels.push_back(seen[k]);
-    track_errors.push_back(forward_errors[k]);
+    track_errors.push_back(errors[k]);
     on_object.push_back(anchor_.moving_region &&
                         anchor_.moving_region->contains(seen[k].x, seen[k].y));
   }
