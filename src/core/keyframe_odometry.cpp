@@ -27,6 +27,10 @@ constexpr double kMovingMemorySeconds = 2.0;
 // With the moving classes left out, a split of motions less than this many times
 // moving_min_px apart is the still scene's own spread.
 constexpr double kSpreadApartFactor = 2.0;
+// The constant-velocity prediction's error is judged over this many trusted frames, once it has
+// at least kPredictionHistoryMin of them.
+constexpr std::size_t kPredictionHistory = 10;
+constexpr std::size_t kPredictionHistoryMin = 3;
 // A split leaves at least this share of the frame's points to the scene, or is not trusted.
 constexpr double kMinSceneShare = 0.3;
 
@@ -86,6 +90,7 @@ void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   reference_self_.reset();
   last_stamp_.reset();
   velocity_.reset();
+  prediction_errors_px_.clear();
   last_trusted_stamp_.reset();
   pose_.setIdentity();
   reference_pose_.setIdentity();
@@ -182,8 +187,13 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   const double from =
       std::isnan(frame.prior->from_stamp) && last_stamp_ ? *last_stamp_ : frame.prior->from_stamp;
   if (velocity_ && std::isfinite(from)) predicted = lie::expSE3(*velocity_ * (frame.stamp - from));
+  double prediction_error_px = 0.0;
+  if (prediction_errors_px_.size() >= kPredictionHistoryMin) {
+    std::vector<double> errors(prediction_errors_px_.begin(), prediction_errors_px_.end());
+    prediction_error_px = medianInPlace(errors);
+  }
   split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
-                        params().motion_split_ratio, predicted);
+                        params().motion_split_ratio, predicted, prediction_error_px);
   // With the moving classes left out by the segmentation, two motions a few pixels apart are
   // the still scene's own spread (near and far tracks of an RGB-D camera, whose depth is older
   // than its colour), not an object: the frame is registered whole and judged by all its tracks.
@@ -783,6 +793,14 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   pose_ = lie::orthonormalized(reference_pose_ * update.motion);
   covariance_ = propagateCovariance(reference_covariance_, update.motion, motion_covariance);
   update.pose = pose_;
+  if (velocity_ && last_trusted_stamp_ && update.stamp > *last_trusted_stamp_ && frame.prior &&
+      !frame.prior->tracked_points.empty()) {
+    const Eigen::Isometry3d predicted =
+        lie::expSE3(*velocity_ * (update.stamp - *last_trusted_stamp_));
+    prediction_errors_px_.push_back(
+        motionsApartPx(*frame.prior, predicted, last_trusted_pose_.inverse() * pose_));
+    if (prediction_errors_px_.size() > kPredictionHistory) prediction_errors_px_.pop_front();
+  }
   if (last_trusted_stamp_ && update.stamp > *last_trusted_stamp_) {
     velocity_ =
         lie::logSE3(last_trusted_pose_.inverse() * pose_) / (update.stamp - *last_trusted_stamp_);

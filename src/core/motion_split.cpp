@@ -13,6 +13,10 @@ namespace {
 // A motion is clearly the nearer to a prediction when at most this fraction as far from it as
 // the other.
 constexpr double kClearlyNearer = 0.5;
+// ... and its distances to the two differ by more than this many of its recent errors: a
+// handheld camera's one-step velocity is several pixels off (TUM fr1_xyz: a median 3.5 px),
+// and a board moving across beside the scene's motion is as near.
+constexpr double kPredictionErrors = 2.0;
 // Tracks of the two motions within this share of the image's width are neighbours; one is in
 // front of the other when at least kFrontMargin nearer; the motion whose tracks are in front in
 // kFrontShare of at least kMinNeighbourPairs such pairs hides the other.
@@ -50,7 +54,8 @@ double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
 }
 
 MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
-                         const std::optional<Eigen::Isometry3d>& predicted) {
+                         const std::optional<Eigen::Isometry3d>& predicted,
+                         double prediction_error_px) {
   MotionSplit split;
   const Eigen::Isometry3d first = prior.motion.inverse(), second = prior.second.motion.inverse();
   std::vector<double> first_depths, second_depths;
@@ -112,8 +117,9 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
   if (predicted) {
     const double to_first = motionsApartPx(prior, *predicted, prior.motion);
     const double to_second = motionsApartPx(prior, *predicted, prior.second.motion);
-    if (to_first <= kClearlyNearer * to_second) nearer_prediction = SceneMotion::kFirst;
-    if (to_second <= kClearlyNearer * to_first) nearer_prediction = SceneMotion::kSecond;
+    const bool told = std::abs(to_first - to_second) > kPredictionErrors * prediction_error_px;
+    if (told && to_first <= kClearlyNearer * to_second) nearer_prediction = SceneMotion::kFirst;
+    if (told && to_second <= kClearlyNearer * to_first) nearer_prediction = SceneMotion::kSecond;
   }
   const auto name = [](SceneMotion m) { return m == SceneMotion::kFirst ? "first" : "second"; };
   if (ratio >= depth_ratio) {

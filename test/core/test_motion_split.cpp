@@ -180,6 +180,24 @@ TEST(MotionSplit, DepthRatioAloneGivesWayToAPredictionNearTheOtherMotion) {
   EXPECT_EQ(unclear.scene, cvo::SceneMotion::kFirst) << unclear.why;
 }
 
+// Proves: a prediction at the other motion vetoes the depth ratio only where its distances to
+// the two motions differ by more than twice its recent error (a handheld camera's one-step
+// velocity is pixels off): as noisy as the motions are apart, it leaves the depth ratio's word.
+TEST(MotionSplit, APredictionAsNoisyAsTheMotionsAreApartVetoesNothing) {
+  const Scene scene = separateObject();
+  const double apart =
+      cvo::motionsApartPx(scene.prior, scene.prior.motion, scene.prior.second.motion);
+  ASSERT_GT(apart, 4.0);
+  const auto splitWithError = [&](double error_px) {
+    return cvo::splitMotions(scene.prior, kParams.motion_split_depth_ratio,
+                             kParams.motion_split_ratio, scene.prior.second.motion, error_px);
+  };
+  const cvo::MotionSplit sure = splitWithError(0.4 * apart);
+  EXPECT_EQ(sure.scene, cvo::SceneMotion::kUndecided) << sure.why;
+  const cvo::MotionSplit noisy = splitWithError(0.6 * apart);
+  EXPECT_EQ(noisy.scene, cvo::SceneMotion::kFirst) << noisy.why;
+}
+
 // Proves: at similar depths a lopsided split picks the motion with far more tracks (first or
 // second), a prediction nearer the smaller one vetoes it, and a balanced split is undecided
 // unless the prediction is nearer the motion with more tracks.

@@ -13,6 +13,7 @@
 // tracks agree with it.
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -242,6 +243,9 @@ class KeyframeOdometry {
   Matrix6d covariance_ = Matrix6d::Zero();                  // of pose_ (body frame)
   // The last good frame-to-frame motion rate (twist per second, [omega; v]).
   std::optional<Vector6d> velocity_;
+  // How far (px, on the tracks) the constant-velocity prediction was from the motion trusted,
+  // over the last trusted frames: how much a prediction can tell two motions apart.
+  std::deque<double> prediction_errors_px_;
   Eigen::Isometry3d last_trusted_pose_ = Eigen::Isometry3d::Identity();
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;

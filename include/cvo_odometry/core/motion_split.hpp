@@ -40,9 +40,12 @@ double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
 // at least `depth_ratio` times the other's and the constant-velocity prediction `predicted`
 // (previous <- current) is not clearly nearer the other; else the motion with more tracks when
 // the other has fewer than `lopsided_ratio` times as many, or when it is also the one nearer
-// the prediction; else undecided. Requires prior.second.solved.
+// the prediction; else undecided. The prediction speaks only where its distances to the two
+// motions differ by more than twice `prediction_error_px` (its recent error, px on the tracks;
+// 0: unknown). Requires prior.second.solved.
 MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
-                         const std::optional<Eigen::Isometry3d>& predicted);
+                         const std::optional<Eigen::Isometry3d>& predicted,
+                         double prediction_error_px = 0.0);
 
 // The prior as the scene sees it: the scene's motion first, its own tracks alone as the inliers
 // (those the other motion explains better left out), the other motion second with its own.
