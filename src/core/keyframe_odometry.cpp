@@ -171,11 +171,13 @@ bool KeyframeOdometry::priorConfident(const std::optional<MotionPrior>& prior) c
 bool KeyframeOdometry::separateSecondMotion(const std::optional<MotionPrior>& prior) const {
   // Static scenes show second motions too, near the first: an RGB-D camera's depth is older than
   // its colour, which moves near and far tracks apart by a pixel or two. Only one whose tracks
-  // move further apart is an object moving on its own; a slower one costs less than a silent
-  // failure's error.
+  // move further apart, or whose depths miss the first motion's alike frame after frame (an
+  // object moving along the rays), is an object moving on its own; a slower one costs less than
+  // a silent failure's error.
   return priorJudges(prior) && prior->second.solved &&
          prior->second.inliers >= params().min_prior_inliers &&
-         motionsApartPx(*prior, prior->motion, prior->second.motion) >= params().moving_min_px;
+         (prior->second.apart_in_depth ||
+          motionsApartPx(*prior, prior->motion, prior->second.motion) >= params().moving_min_px);
 }
 
 std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {

@@ -53,6 +53,10 @@ struct MotionPrior {
     // from (the first motion is then solved from the other tracks).
     int known_object = 0;
     std::vector<Eigen::Vector2f, Eigen::aligned_allocator<Eigen::Vector2f>> pixels;
+    // Its tracks' depths in the current frame miss the first motion's prediction alike, frame
+    // after frame (FeatureTracker: median miss against the first motion's tracks' spread), where
+    // the image may not tell the motions apart: an object moving along the view's rays.
+    bool apart_in_depth = false;
   } second;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
   std::string problem;    // why no motion was solved

@@ -84,6 +84,9 @@ class FeatureTracker {
     std::vector<cv::Point2f> pixels;                   // where its image sees them
     std::vector<cv::Mat> pyramid;                      // of its image
     std::shared_ptr<const PixelRegion> moving_region;  // in its image, or null
+    // Where its image saw the tracks of a second motion whose depths missed the first's
+    // prediction (MotionPrior::SecondMotion::apart_in_depth) when it was the current frame.
+    std::vector<cv::Point2f> depth_shifted;
     double stamp = std::numeric_limits<double>::quiet_NaN();
     bool empty() const { return points.empty() || pyramid.empty(); }
   };
@@ -103,8 +106,12 @@ class FeatureTracker {
   MotionPrior trackAndSeed(const cv::Mat& grey, const cv::Mat& depth,
                            const PinholeIntrinsics& intrinsics, int crop_top_rows,
                            const cv::Mat& excluded, double stamp);
-  MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Size& size,
-                    const PinholeIntrinsics& intrinsics, const cv::Mat& excluded) const;
+  // The prior from the anchor's corners tracked into `current` (the current frame's pyramid;
+  // `depth` its depth image, CV_32FC1, or empty). `depth_shifted`: where the second motion's
+  // tracks' depths missed the first's (none when they did not).
+  MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Mat& depth,
+                    const cv::Size& size, const PinholeIntrinsics& intrinsics,
+                    const cv::Mat& excluded, std::vector<cv::Point2f>* depth_shifted) const;
   // Per track of `which` (`points` seen at `from_pixels`, with KLT's `track_errors`): true where
   // KLT, started where `current_from_previous` puts it, settles there too with a patch about as
   // alike as its own track's (a repeating texture).
