@@ -184,6 +184,19 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   split_.reset();
   if (!separateSecondMotion(frame.prior)) return "";
   moving_seen_stamp_ = frame.stamp;
+  // With the moving classes left out by the segmentation, two motions a few pixels apart are
+  // the still scene's own spread (near and far tracks of an RGB-D camera, whose depth is older
+  // than its colour), not an object: the frame is registered whole and judged by all its tracks.
+  // TUM with a board approaching, labelled (bench/dynamic_table.sh's "towards"): frames whose
+  // view the board halves split this way, 7.0 and 7.5 px apart, near tracks against far ones;
+  // leaving the near ones' region out (two thirds of the points) pulled the registration 12 px
+  // off the tracks. Motions further apart than twice moving_min_px are an object of a class not
+  // left out, split as without labels.
+  if (frame.moving_classes_left_out &&
+      motionsApartPx(*frame.prior, frame.prior->motion, frame.prior->second.motion) <
+          kSpreadApartFactor * params().moving_min_px) {
+    return "";
+  }
   // The camera's last velocity predicts this step (previous <- current).
   std::optional<Eigen::Isometry3d> predicted;
   const double from =
@@ -196,20 +209,6 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   }
   split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
                         params().motion_split_ratio, predicted, prediction_error_px);
-  // With the moving classes left out by the segmentation, two motions a few pixels apart are
-  // the still scene's own spread (near and far tracks of an RGB-D camera, whose depth is older
-  // than its colour), not an object: the frame is registered whole and judged by all its tracks.
-  // TUM with a board approaching, labelled (bench/dynamic_table.sh's "towards"): frames whose
-  // view the board halves split this way, 7.0 and 7.5 px apart, near tracks against far ones;
-  // leaving the near ones' region out (two thirds of the points) pulled the registration 12 px
-  // off the tracks. Motions further apart than twice moving_min_px are an object of a class not
-  // left out, split as without labels.
-  if (frame.moving_classes_left_out &&
-      motionsApartPx(*frame.prior, frame.prior->motion, frame.prior->second.motion) <
-          kSpreadApartFactor * params().moving_min_px) {
-    split_.reset();
-    return "";
-  }
   if (split_->scene == SceneMotion::kUndecided) return split_->why;
   MotionPrior scene = sceneFirst(*frame.prior, *split_);
   std::shared_ptr<const LabeledCloud> rest = withoutRegion(frame.cloud, scene, scene.second.pixels);
