@@ -10,9 +10,9 @@
 #include <stdexcept>
 #include <string>
 
-#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "cvo_odometry/frontend/block_costs.hpp"
 #include "cvo_odometry/frontend/color_features.hpp"
 #include "cvo_odometry/frontend/stereo_matcher.hpp"
 
@@ -20,7 +20,7 @@ namespace cvo {
 
 namespace {
 
-constexpr int kLanes = 16;  // costs computed 16 disparities at a time
+constexpr int kReadBeyond = 16;  // bytes blockCosts may read beyond a window row
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 int roundUp(int n, int multiple) {
@@ -45,60 +45,6 @@ void prefilter(const cv::Mat& grey, int row0, int cap, int pad, cv::Mat* out) {
       o[x] = static_cast<std::uint8_t>(std::clamp(d, -cap, cap) + cap);
     }
   }
-}
-
-// costs[i] = sum over the window's pixels (rows a[r], b[r] for r < rows, columns -h..h) of
-// |a[r][c] - b[r][c + i]|, for i in [0, n) (n a multiple of kLanes): a's pixel against
-// consecutive pixels of b.
-void windowCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int h, int rows, int n,
-                 std::uint16_t* costs) {
-  for (int k = 0; k < n; k += kLanes) {
-#if CV_SIMD128
-    cv::v_uint16x8 low = cv::v_setzero_u16(), high = cv::v_setzero_u16();
-    for (int r = 0; r < rows; ++r) {
-      const std::uint8_t* ar = a[r];
-      const std::uint8_t* br = b[r] + k;
-      for (int c = -h; c <= h; ++c) {
-        cv::v_uint16x8 l, u;
-        cv::v_expand(cv::v_absdiff(cv::v_load(br + c), cv::v_setall_u8(ar[c])), l, u);
-        low += l;
-        high += u;
-      }
-    }
-    cv::v_store(costs + k, low);
-    cv::v_store(costs + k + 8, high);
-#else
-    std::uint16_t sums[kLanes] = {};
-    for (int r = 0; r < rows; ++r) {
-      for (int c = -h; c <= h; ++c) {
-        const int value = a[r][c];
-        for (int i = 0; i < kLanes; ++i)
-          sums[i] = static_cast<std::uint16_t>(sums[i] + std::abs(value - b[r][c + k + i]));
-      }
-    }
-    std::copy(sums, sums + kLanes, costs + k);
-#endif
-  }
-}
-
-// The sum of |a[r][c] - b[r][c]| over rows r < rows and columns c < width (<= kLanes).
-int rowSad(const std::uint8_t* const* a, const std::uint8_t* const* b, int rows, int width) {
-#if CV_SIMD128
-  std::uint8_t keep[kLanes];
-  for (int i = 0; i < kLanes; ++i)
-    keep[i] = i < width ? 0xff : 0;
-  const cv::v_uint8x16 mask = cv::v_load(keep);
-  unsigned sum = 0;
-  for (int r = 0; r < rows; ++r)
-    sum += cv::v_reduce_sad(cv::v_load(a[r]) & mask, cv::v_load(b[r]) & mask);
-  return static_cast<int>(sum);
-#else
-  int sum = 0;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < width; ++c)
-      sum += std::abs(a[r][c] - b[r][c]);
-  return sum;
-#endif
 }
 
 }  // namespace
@@ -173,7 +119,7 @@ void PointStereoMatcher::prepare(const cv::Mat& left, const cv::Mat& right, int 
   size_ = left.size();
   first_row_ = first_row;
   row0_ = std::max(0, first_row - std::max(h, options_.refine_height / 2));
-  pad_ = std::abs(options_.min_disparity) + options_.num_disparities + 2 * kLanes + h;
+  pad_ = std::abs(options_.min_disparity) + options_.num_disparities + 2 * kReadBeyond + h;
   coarse_.release();
   // Three independent parts, spread over OpenCV's threads (the coarse SGBM, the longest, first;
   // inside this loop it runs on one thread).
@@ -246,8 +192,8 @@ bool PointStereoMatcher::searchInterval(int x, int y, int* lo, int* hi) const {
     }
     if (low > high) return false;  // no coarse disparity around the pixel
     // Fixed point x16 at 1/2^level: (d << level) / 16 px at full resolution. (Widening it to
-    // the lanes the costs come in anyway, 16, lost pixels to the uniqueness test: KITTI 06,
-    // stereo_point_precision, 0.770 -> 0.750 of the tracks with a disparity.)
+    // 16 disparities lost pixels to the uniqueness test: KITTI 06, stereo_point_precision,
+    // 0.770 -> 0.750 of the tracks with a disparity.)
     from = std::max(from, ((low << level) >> 4) - options_.search_radius);
     to = std::min(to, (((high << level) + 15) >> 4) + options_.search_radius);
   }
@@ -270,9 +216,9 @@ std::vector<float> PointStereoMatcher::match(const std::vector<cv::Point>& pixel
     }
   }
   std::vector<float> out(pixels.size(), kNaN);
-  const int lanes = roundUp(options_.num_disparities + 2, kLanes) + kLanes;
   const auto body = [&](const cv::Range& range) {
-    std::vector<std::uint16_t> costs(static_cast<std::size_t>(2 * lanes));
+    // The costs of disparities lo - 1 .. hi + 1 and those of the match back.
+    std::vector<std::uint16_t> costs(static_cast<std::size_t>(2 * (options_.num_disparities + 2)));
     for (int k = range.start; k < range.end; ++k)
       out[static_cast<std::size_t>(k)] = matchOne(pixels[k].x, pixels[k].y, costs);
   };
@@ -300,10 +246,9 @@ float PointStereoMatcher::matchOne(int x, int y, std::vector<std::uint16_t>& cos
     left_rows[r] = left_.ptr<std::uint8_t>(y - h + r - row0_) + pad_;
     right_rows[r] = right_.ptr<std::uint8_t>(y - h + r - row0_) + pad_;
   }
-  // Left to right: lane i holds disparity top - i (the right image's pixels x - top + i, in
-  // increasing order), for disparities lo - 1 .. hi + 1.
-  const int lanes = roundUp(hi - lo + 3, kLanes);
-  const int top = lo - 1 + lanes - 1;
+  // Left to right: cost[i] is disparity hi + 1 - i's (the right image's pixels x - hi - 1 + i,
+  // in increasing order), for disparities lo - 1 .. hi + 1.
+  const int top = hi + 1;
   const std::uint8_t* a[32];
   const std::uint8_t* b[32];
   for (int r = 0; r < side; ++r) {
@@ -311,7 +256,7 @@ float PointStereoMatcher::matchOne(int x, int y, std::vector<std::uint16_t>& cos
     b[r] = right_rows[r] + x - top;
   }
   std::uint16_t* cost = costs.data();
-  windowCosts(a, b, h, side, lanes, cost);
+  blockCosts(a, b, h, side, 0, hi - lo + 3, cost);
   const auto at = [&](int d) { return static_cast<int>(cost[top - d]); };
   int best = lo;
   for (int d = lo + 1; d <= hi; ++d) {
@@ -324,16 +269,15 @@ float PointStereoMatcher::matchOne(int x, int y, std::vector<std::uint16_t>& cos
   for (int d = lo; d <= hi; ++d) {
     if (std::abs(d - best) > 1 && at(d) * unique < best_cost * 100) return kNaN;
   }
-  // Right to left: the right pixel x - best against the left pixels x - best + d, lane i for
+  // Right to left: the right pixel x - best against the left pixels x - best + d, back[i] for
   // disparity lo + i.
   const int xr = x - best;
-  const int back_lanes = roundUp(hi - lo + 1, kLanes);
   for (int r = 0; r < side; ++r) {
     a[r] = right_rows[r] + xr;
     b[r] = left_rows[r] + xr + lo;
   }
-  std::uint16_t* back = costs.data() + lanes;
-  windowCosts(a, b, h, side, back_lanes, back);
+  std::uint16_t* back = costs.data() + (hi - lo + 3);
+  blockCosts(a, b, h, side, 0, hi - lo + 1, back);
   int back_best = lo;
   for (int d = lo + 1; d <= hi; ++d) {
     if (xr + d + h >= size_.width) break;  // the left window leaves the image
@@ -359,16 +303,18 @@ float PointStereoMatcher::refine(int x, int y, int best, int lo, int hi, const s
   const int rows = 2 * hr + 1;
   const std::uint8_t* a[32];
   const std::uint8_t* b[32];
-  for (int r = 0; r < rows; ++r)
-    a[r] = left_.ptr<std::uint8_t>(y - hr + r - row0_) + pad_ + x - w;
-  // Costs of disparities best - 2 .. best + 2 (those in the searched interval and beside it).
-  int wide[5];
+  // Costs of disparities best - 2 .. best + 2 (those in the searched interval and beside it):
+  // wide[d - best + 2] for d in [first, last].
   const int first = std::max(best - 2, lo - 1), last = std::min(best + 2, hi + 1);
-  for (int d = first; d <= last; ++d) {
-    for (int r = 0; r < rows; ++r)
-      b[r] = right_.ptr<std::uint8_t>(y - hr + r - row0_) + pad_ + x - w - d;
-    wide[d - best + 2] = rowSad(a, b, rows, 2 * w + 1);
+  for (int r = 0; r < rows; ++r) {
+    a[r] = left_.ptr<std::uint8_t>(y - hr + r - row0_) + pad_ + x;
+    b[r] = right_.ptr<std::uint8_t>(y - hr + r - row0_) + pad_ + x - last;
   }
+  std::uint16_t by_shift[5];  // by_shift[i]: disparity last - i
+  blockCosts(a, b, w, rows, 0, last - first + 1, by_shift);
+  int wide[5];
+  for (int d = first; d <= last; ++d)
+    wide[d - best + 2] = by_shift[last - d];
   int centre = best;
   for (int d : {best - 1, best + 1}) {
     if (d - 1 >= first && d + 1 <= last && wide[d - best + 2] < wide[centre - best + 2]) centre = d;

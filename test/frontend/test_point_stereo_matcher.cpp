@@ -7,11 +7,13 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "cvo_odometry/frontend/block_costs.hpp"
 #include "cvo_odometry/frontend/builtin_presets.hpp"
 #include "cvo_odometry/frontend/point_stereo_matcher.hpp"
 #include "cvo_odometry/frontend/stereo_cloud_builder.hpp"
@@ -44,6 +46,42 @@ std::vector<cv::Point> corners(const cv::Mat& left) {
 double median(std::vector<float> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
+}
+
+// The vectorised block costs against the pixel-by-pixel sums, on the KITTI pair's rows (padded
+// by 16 bytes, all the costs may read beyond a window row): every window the matcher and its
+// refinement use (square 1-31 px, 15 x 5) and windows wider than one 16-byte piece, at shifts
+// from 0 up to past a 16-lane boundary.
+TEST(BlockCosts, EqualThePixelByPixelSums) {
+  cv::Mat left, right;
+  cv::copyMakeBorder(readGrey(kPair + "/left.png"), left, 0, 0, 48, 48, cv::BORDER_REFLECT_101);
+  cv::copyMakeBorder(readGrey(kPair + "/right.png"), right, 0, 0, 48, 48, cv::BORDER_REFLECT_101);
+  struct Window {
+    int h, rows;
+  };
+  int compared = 0;
+  for (const Window window : {Window{0, 1}, Window{1, 3}, Window{2, 5}, Window{3, 7}, Window{3, 4},
+                              Window{7, 5}, Window{7, 21}, Window{9, 3}, Window{15, 2}}) {
+    for (int y = 150; y + window.rows < left.rows; y += 37) {
+      for (int x = 80; x + 80 < left.cols; x += 53) {
+        const std::uint8_t* a[32];
+        const std::uint8_t* b[32];
+        for (int r = 0; r < window.rows; ++r) {
+          a[r] = left.ptr<std::uint8_t>(y + r) + x;
+          b[r] = right.ptr<std::uint8_t>(y + r) + x - 40;
+        }
+        for (const auto& [from, to] : {std::pair{0, 1}, std::pair{0, 18}, std::pair{5, 38}}) {
+          std::vector<std::uint16_t> fast(static_cast<std::size_t>(to - from)), plain = fast;
+          cvo::blockCosts(a, b, window.h, window.rows, from, to, fast.data());
+          cvo::blockCostsOneByOne(a, b, window.h, window.rows, from, to, plain.data());
+          ASSERT_EQ(fast, plain) << "window " << 2 * window.h + 1 << " x " << window.rows
+                                 << " at (" << x << ", " << y << "), shifts " << from << ".." << to;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 500);
 }
 
 class PointMatcherLevels : public ::testing::TestWithParam<int> {};
