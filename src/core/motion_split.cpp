@@ -24,6 +24,11 @@ constexpr double kNeighbourShare = 0.075;
 constexpr double kFrontMargin = 0.05;
 constexpr double kFrontShare = 0.75;
 constexpr int kMinNeighbourPairs = 10;
+// Occlusion and depth both take the object to be in front: tracks behind at the boundary whose
+// median depth is this many times nearer than the other motion's contradict that. (KITTI with a
+// truck driving along, stride 2: the road in front of the truck is its neighbour below, nearer,
+// and made the truck's tracks the ones behind.)
+constexpr double kContradictingDepthRatio = 2.0;
 // A second motion at least this share of whose tracks start on the object of the frame they
 // start from is that object's.
 constexpr double kKnownObjectShare = 0.5;
@@ -103,6 +108,18 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
       why << "; " << std::max(first_in_front, second_in_front) << " of " << pairs
           << " neighbouring pairs have the " << (behind == SceneMotion::kFirst ? "second" : "first")
           << " motion's track in front";
+    }
+  }
+  if (behind) {
+    const double behind_depth =
+        *behind == SceneMotion::kFirst ? split.first_depth : split.second_depth;
+    const double front_depth =
+        *behind == SceneMotion::kFirst ? split.second_depth : split.first_depth;
+    if (front_depth >= kContradictingDepthRatio * behind_depth) {
+      why << ", yet those tracks are " << front_depth / behind_depth
+          << " times as far by median depth: the evidence contradicts itself";
+      split.why = why.str();
+      return split;
     }
   }
   const SceneMotion farther = behind                                    ? *behind

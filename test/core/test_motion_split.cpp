@@ -245,6 +245,27 @@ TEST(MotionSplit, TheObjectKnownFromTheLastFrameSettlesABalancedSplit) {
 // Proves: sceneFirst puts the scene's motion first (swapping when the scene follows the second)
 // and gives each motion its own tracks only: the inlier set is the scene's tracks, the second
 // motion's pixels the object's, no track in both.
+// Proves: occlusion that contradicts the depths by far leaves the split undecided. A truck
+// (8 m, most tracks) driving along, the road just below it (6 m, the camera's motion: nearer, so
+// "in front" of the truck's tracks it neighbours) and the background far away (40 m, beyond the
+// neighbour reach): the pairs make the truck's tracks the ones behind, though the camera's
+// motion's tracks are five times as far by median depth.
+TEST(MotionSplit, OcclusionThatContradictsTheDepthsIsUndecided) {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d truck = objectMotion(camera, Eigen::Vector3d(0.5, 0.0, 0.0));
+  Scene scene = emptyScene(truck, camera);
+  addTracks(&scene, truck, 0, 240, 400, 160, 320, 10.0, 8.0);
+  addTracks(&scene, camera, 1, 240, 400, 330, 370, 20.0, 6.0);  // the road below it
+  addTracks(&scene, camera, 1, 20, 620, 20, 100, 20.0, 40.0);   // far away, above
+  const cvo::MotionSplit s = split(scene.prior);
+  ASSERT_EQ(s.first_tracks, count(scene.truth, 0));
+  ASSERT_GT(s.second_depth, 2.0 * s.first_depth) << s.why;
+  EXPECT_EQ(s.scene, cvo::SceneMotion::kUndecided) << s.why;
+  EXPECT_NE(s.why.find("second motion's track in front"), std::string::npos)
+      << "the road's tracks must be in front of the truck's: " << s.why;
+  EXPECT_NE(s.why.find("contradicts itself"), std::string::npos) << s.why;
+}
+
 TEST(MotionSplit, SceneFirstSwapsMotionsAndGivesExclusiveInlierSets) {
   const Scene scene = occludingObject();
   const cvo::MotionSplit s = split(scene.prior);
