@@ -213,10 +213,10 @@ MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split) {
     }
   }
   out.inliers = static_cast<int>(out.points.size());
-  out.inlier_ratio = prior.tracked_points.empty()
-                         ? 0.0
-                         : static_cast<double>(out.inliers) / prior.tracked_points.size();
   out.second.inliers = static_cast<int>(out.second.pixels.size());
+  // Of the tracks the other motion leaves: its own are no evidence against the scene's.
+  const std::size_t left = prior.tracked_points.size() - out.second.pixels.size();
+  out.inlier_ratio = left == 0 ? 0.0 : static_cast<double>(out.inliers) / left;
   if (swap) std::swap(out.motion, out.second.motion);
   return out;
 }
