@@ -852,21 +852,19 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     update.state = TrackingState::kReset;
     update.has_pose = p.lost_frame_policy != LostFramePolicy::kPublishNothing;
     // A new stretch starts here: its reference is no guess (the silent failure count judges no
-    // pair across a restart), yet beside something moving the tracks from the last trusted
-    // frame still judge the frames after it (restart_tracks below).
+    // pair across a restart).
     setReference(frame.cloud, update.stamp);
     update.new_keyframe = reference_ != nullptr;
     velocity_.reset();
     last_trusted_pose_ = pose_;
     last_trusted_stamp_ = update.stamp;
     lost_frames_ = 0;
-    // The tracks start again from this frame, unless something moved lately: then only tracks
-    // from the last trusted frame can tell its guessed pose from the truth, and the next frames
-    // stay untrusted until they do or the scene has been still for a while.
-    const bool moving_lately =
-        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
-    update.restart_tracks = !moving_lately;
-    if (update.restart_tracks) frames_since_anchor_ = 0;
+    // The tracks start again from this frame, beside something moving too: the last trusted
+    // frame is more than max_lost_frames behind, too far for its tracks to judge anything
+    // (priorFramePose), and without tracks a KITTI car got no guess and no judge until the
+    // moving object was 2 s in the past (a van crossing: 20 of 50 frames lost, 4 restarts).
+    update.restart_tracks = true;
+    frames_since_anchor_ = 0;
     return;
   }
   update.state = TrackingState::kLost;
