@@ -78,6 +78,9 @@ void printEvaluationReport(std::ostream& out, const EvaluationReport& r,
   if (r.judged_trust) {
     out << "silent failures: " << r.silent.failures << " of " << r.silent.judged
         << " trusted frames (motion error > 50 % of the step and 2 cm, or > 1 deg)\n";
+    out << std::setprecision(6) << "trusted frame-to-frame (" << r.silent.judged
+        << " pairs, none across a restart): " << r.silent.translation_rmse << " m, "
+        << r.silent.rotation_rmse_deg << " deg\n";
   }
 }
 

@@ -195,9 +195,15 @@ SilentFailures countSilentFailures(const AssociatedPoses& poses,
     const double t = error.translation().norm();
     const double r = Eigen::AngleAxisd(error.rotation()).angle() * 180.0 / M_PI;
     ++result.judged;
+    result.translation_rmse += t * t;
+    result.rotation_rmse_deg += r * r;
     if ((t > fraction * truth.translation().norm() && t > min_error_m) || r > max_rotation_deg) {
       ++result.failures;
     }
+  }
+  if (result.judged > 0) {
+    result.translation_rmse = std::sqrt(result.translation_rmse / result.judged);
+    result.rotation_rmse_deg = std::sqrt(result.rotation_rmse_deg / result.judged);
   }
   return result;
 }

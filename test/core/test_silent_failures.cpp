@@ -101,6 +101,10 @@ TEST(SilentFailures, PairAcrossARestartIsNotJudged) {
       cvo::countSilentFailures(run.poses, run.trusted, 0.5, 0.02, 1.0, {stampOf(6)});
   EXPECT_EQ(with.judged, static_cast<std::size_t>(kFrames - 2)) << "(5, 6) not judged";
   EXPECT_EQ(with.failures, 0u);
+  // The judged pairs' error leaves the jump out: the steps are the truth's.
+  EXPECT_GT(without.translation_rmse, 0.01);
+  EXPECT_NEAR(with.translation_rmse, 0.0, 1e-9);
+  EXPECT_NEAR(with.rotation_rmse_deg, 0.0, 1e-6);
   // A restart stamp between an untrusted frame and the trusted one after it ends the stretch
   // too: frame 5 untrusted, restart stamped at frame 5, frame 6 not judged against frame 4.
   run.distrust(5);

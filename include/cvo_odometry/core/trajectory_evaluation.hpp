@@ -76,6 +76,10 @@ std::vector<double> kittiDriftLengths();
 struct SilentFailures {
   std::size_t judged = 0;  // trusted frames with ground truth at them and the previous one
   std::size_t failures = 0;
+  // RMS error of the judged pairs' motion (none across a restart, where the pose holds while
+  // the camera moved on): what a user of the trusted poses sees frame to frame.
+  double translation_rmse = 0.0;
+  double rotation_rmse_deg = 0.0;
 };
 SilentFailures countSilentFailures(const AssociatedPoses& poses,
                                    const std::vector<double>& trusted_stamps, double fraction = 0.5,
