@@ -34,13 +34,13 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=true peers_on=false ;;
     --extra) more_cases=true ;;
-    --stride) stride=$2; shift ;;
+    --stride) stride=${2:-none}; [ $# -lt 2 ] || shift ;;
     --check) check=true ;;
     --no-peers) peers_on=false ;;
     --tum) tum=$2; shift ;;
     --kitti) kitti=$2; shift ;;
     --bin) bin=$2; shift ;;
-    *) sed -n '3,23p' "$0" >&2; exit 2 ;;
+    *) sed -n '3,26p' "$0" >&2; exit 2 ;;
   esac
   shift
 done

@@ -859,12 +859,16 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     last_trusted_pose_ = pose_;
     last_trusted_stamp_ = update.stamp;
     lost_frames_ = 0;
-    // The tracks start again from this frame, beside something moving too: the last trusted
-    // frame is more than max_lost_frames behind, too far for its tracks to judge anything
-    // (priorFramePose), and without tracks a KITTI car got no guess and no judge until the
-    // moving object was 2 s in the past (a van crossing: 20 of 50 frames lost, 4 restarts).
-    update.restart_tracks = true;
-    frames_since_anchor_ = 0;
+    // The tracks start again from this frame, unless something moved lately and the last
+    // trusted frame is near enough for its tracks to judge (priorFramePose: lost_frame_policy
+    // reset restarts at the first lost frame): they tell the restart's guessed pose from the
+    // truth. After max_lost_frames they judge nothing, and without tracks a KITTI car got no
+    // guess and no judge until the motion was 2 s in the past (a van crossing: 20 of 50 frames
+    // lost, 4 restarts).
+    const bool moving_lately =
+        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    update.restart_tracks = !moving_lately || frames_since_anchor_ > p.max_lost_frames;
+    if (update.restart_tracks) frames_since_anchor_ = 0;
     return;
   }
   update.state = TrackingState::kLost;

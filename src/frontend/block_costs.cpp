@@ -1,7 +1,9 @@
 #include "cvo_odometry/frontend/block_costs.hpp"
 
+#include <algorithm>
 #include <cstdlib>
-#include <cstring>
+
+#include <opencv2/core/hal/intrin.hpp>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -17,6 +19,31 @@ void blockCostsOneByOne(const std::uint8_t* const* a, const std::uint8_t* const*
       for (int c = -h; c <= h; ++c)
         sum += std::abs(a[r][c] - b[r][c + i]);
     costs[i - from] = static_cast<std::uint16_t>(sum);
+  }
+}
+
+void blockCostsInLanes(const std::uint8_t* const* a, const std::uint8_t* const* b, int h,
+                       int rows, int from, int to, std::uint16_t* costs) {
+  constexpr int kLanes = 16;
+  for (int k = from; k < to; k += kLanes) {
+    std::uint16_t lanes[kLanes];
+#if CV_SIMD128
+    cv::v_uint16x8 low = cv::v_setzero_u16(), high = cv::v_setzero_u16();
+    for (int r = 0; r < rows; ++r) {
+      const std::uint8_t* br = b[r] + k;
+      for (int c = -h; c <= h; ++c) {
+        cv::v_uint16x8 l, u;
+        cv::v_expand(cv::v_absdiff(cv::v_load(br + c), cv::v_setall_u8(a[r][c])), l, u);
+        low += l;
+        high += u;
+      }
+    }
+    cv::v_store(lanes, low);
+    cv::v_store(lanes + 8, high);
+#else
+    blockCostsOneByOne(a, b, h, rows, k, k + kLanes, lanes);
+#endif
+    std::copy(lanes, lanes + std::min(kLanes, to - k), costs + (k - from));
   }
 }
 
@@ -97,7 +124,7 @@ void blockCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int 
 
 void blockCosts(const std::uint8_t* const* a, const std::uint8_t* const* b, int h, int rows,
                 int from, int to, std::uint16_t* costs) {
-  blockCostsOneByOne(a, b, h, rows, from, to, costs);
+  blockCostsInLanes(a, b, h, rows, from, to, costs);
 }
 
 #endif

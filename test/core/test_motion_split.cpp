@@ -242,9 +242,6 @@ TEST(MotionSplit, TheObjectKnownFromTheLastFrameSettlesABalancedSplit) {
   EXPECT_EQ(against.scene, cvo::SceneMotion::kUndecided) << against.why;
 }
 
-// Proves: sceneFirst puts the scene's motion first (swapping when the scene follows the second)
-// and gives each motion its own tracks only: the inlier set is the scene's tracks, the second
-// motion's pixels the object's, no track in both.
 // Proves: occlusion that contradicts the depths by far leaves the split undecided. A truck
 // (8 m, most tracks) driving along, the road just below it (6 m, the camera's motion: nearer, so
 // "in front" of the truck's tracks it neighbours) and the background far away (40 m, beyond the
@@ -266,6 +263,9 @@ TEST(MotionSplit, OcclusionThatContradictsTheDepthsIsUndecided) {
   EXPECT_NE(s.why.find("contradicts itself"), std::string::npos) << s.why;
 }
 
+// Proves: sceneFirst puts the scene's motion first (swapping when the scene follows the second)
+// and gives each motion its own tracks only: the inlier set is the scene's tracks, the second
+// motion's pixels the object's, no track in both.
 TEST(MotionSplit, SceneFirstSwapsMotionsAndGivesExclusiveInlierSets) {
   const Scene scene = occludingObject();
   const cvo::MotionSplit s = split(scene.prior);

@@ -48,10 +48,10 @@ double median(std::vector<float> values) {
   return values[values.size() / 2];
 }
 
-// The vectorised block costs against the pixel-by-pixel sums, on the KITTI pair's rows (padded
-// by 16 bytes, all the costs may read beyond a window row): every window the matcher and its
-// refinement use (square 1-31 px, 15 x 5) and windows wider than one 16-byte piece, at shifts
-// from 0 up to past a 16-lane boundary.
+// Both vectorised block costs (psadbw where there is SSE2, OpenCV's 16 lanes elsewhere) against
+// the pixel-by-pixel sums, on the KITTI pair's rows (padded by 48 bytes, more than the costs
+// read beyond a window row): windows of the matcher and its refinement (7 x 7, 15 x 5, up to
+// 15 x 21) and wider than one 16-byte piece, at shifts from 0 up to past a 16-lane boundary.
 TEST(BlockCosts, EqualThePixelByPixelSums) {
   cv::Mat left, right;
   cv::copyMakeBorder(readGrey(kPair + "/left.png"), left, 0, 0, 48, 48, cv::BORDER_REFLECT_101);
@@ -71,11 +71,15 @@ TEST(BlockCosts, EqualThePixelByPixelSums) {
           b[r] = right.ptr<std::uint8_t>(y + r) + x - 40;
         }
         for (const auto& [from, to] : {std::pair{0, 1}, std::pair{0, 18}, std::pair{5, 38}}) {
-          std::vector<std::uint16_t> fast(static_cast<std::size_t>(to - from)), plain = fast;
+          std::vector<std::uint16_t> fast(static_cast<std::size_t>(to - from)), lanes = fast,
+                                                                                plain = fast;
           cvo::blockCosts(a, b, window.h, window.rows, from, to, fast.data());
+          cvo::blockCostsInLanes(a, b, window.h, window.rows, from, to, lanes.data());
           cvo::blockCostsOneByOne(a, b, window.h, window.rows, from, to, plain.data());
           ASSERT_EQ(fast, plain) << "window " << 2 * window.h + 1 << " x " << window.rows
                                  << " at (" << x << ", " << y << "), shifts " << from << ".." << to;
+          ASSERT_EQ(lanes, plain) << "16 lanes, window " << 2 * window.h + 1 << " x "
+                                  << window.rows << " at (" << x << ", " << y << ")";
           ++compared;
         }
       }

@@ -36,7 +36,8 @@ double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
 
 // Splits the prior's tracks between its two motions and decides which the scene follows: the
 // motion of the tracks behind, where the two motions' tracks are image neighbours and one's
-// are in front in most pairs (occlusion); else the farther tracks' when their median depth is
+// are in front in most pairs (occlusion; undecided when the tracks behind are by median depth
+// half as far as the others or less: the evidence contradicts itself); else the farther tracks' when their median depth is
 // at least `depth_ratio` times the other's and the constant-velocity prediction `predicted`
 // (previous <- current) is not clearly nearer the other; else the motion with more tracks when
 // the other has fewer than `lopsided_ratio` times as many, or when it is also the one nearer
