@@ -137,6 +137,10 @@ void KeyframeOdometry::checkStamp(double stamp) const {
   }
 }
 
+bool KeyframeOdometry::movedLately(double stamp) const {
+  return moving_seen_stamp_ && stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+}
+
 std::optional<Eigen::Isometry3d> KeyframeOdometry::constantVelocityMotion(double interval) const {
   if (!velocity_) return std::nullopt;
   return lie::orthonormalized(reference_pose_.inverse() * pose_ *
@@ -448,8 +452,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     // The cosine alone does not judge a registration to a lost frame (its motion may be right,
     // but the pose is the guess's times it) nor one beside an object moving through the view
     // (it scores a registration the object pulled like a right one): tracks must.
-    const bool moving_lately =
-        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    const bool moving_lately = movedLately(frame.stamp);
     if (reference_guessed_ || moving_lately) {
       a.good = false;
       a.problems = reference_guessed_
@@ -505,8 +508,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
         angleDeg(frame.prior->motion.inverse() * prior_from_reference * a.result.transform);
     // Beside something moving the dense stages may be pulled a little off the tracks, too
     // little for the pixel bound yet enough for a wrong pose: more of the tracks must agree.
-    const bool moving_lately =
-        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    const bool moving_lately = movedLately(frame.stamp);
     const double needed = moving_lately ? std::max(p.min_track_agreement, p.moving_track_agreement)
                                         : p.min_track_agreement;
     if (a.agreement >= needed && a.track_rotation_gap_deg > p.max_track_rotation_gap) {
@@ -652,8 +654,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   // (attemptWithConsistentPoints): an object without corners of its own pulls a registration of
   // every point off the tracks by a few pixels, within what they allow. They register from the
   // tracks' motion: only where the prior may be a guess.
-  const bool moving_lately =
-      moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+  const bool moving_lately = movedLately(frame.stamp);
   const bool prior_guesses = params().initial_guess == InitialGuess::kAuto ||
                              params().initial_guess == InitialGuess::kFeatures;
   if (moving_lately && prior_guesses && priorConfident(frame.prior)) {
@@ -865,8 +866,7 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // truth. After max_lost_frames they judge nothing, and without tracks a KITTI car got no
     // guess and no judge until the motion was 2 s in the past (a van crossing: 20 of 50 frames
     // lost, 4 restarts).
-    const bool moving_lately =
-        moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+    const bool moving_lately = movedLately(frame.stamp);
     update.restart_tracks = !moving_lately || frames_since_anchor_ > p.max_lost_frames;
     if (update.restart_tracks) frames_since_anchor_ = 0;
     return;
@@ -874,8 +874,7 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
   update.state = TrackingState::kLost;
   update.has_pose = p.lost_frame_policy == LostFramePolicy::kKeepGuess;
   // Beside something moving the prior may have followed it in part: the trusted reference stays.
-  const bool moving_lately =
-      moving_seen_stamp_ && frame.stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
+  const bool moving_lately = movedLately(frame.stamp);
   if (previous_placed_by_prior_ && !moving_lately && frame.cloud &&
       frame.cloud->size() >= static_cast<std::size_t>(p.min_tracking_points)) {
     // Placed by a confident prior: the next frame is registered to this one, one step away,

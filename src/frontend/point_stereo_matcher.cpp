@@ -20,7 +20,8 @@ namespace cvo {
 
 namespace {
 
-constexpr int kReadBeyond = 16;  // bytes blockCosts may read beyond a window row
+// Bytes blockCosts reads beyond a window row at most (twice that: blockCostsInLanes).
+constexpr int kReadBeyond = 16;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 int roundUp(int n, int multiple) {

@@ -207,6 +207,8 @@ class KeyframeOdometry {
   OdometryUpdate startFrom(const OdometryFrame& frame);
   // reference <- current if the camera kept its velocity since the previous frame.
   std::optional<Eigen::Isometry3d> constantVelocityMotion(double interval) const;
+  // Something moved in view within kMovingMemorySeconds before `stamp` (moving_seen_stamp_).
+  bool movedLately(double stamp) const;
   Eigen::Isometry3d stillMotion() const;  // reference <- previous frame
   // start <- the frame the prior's tracks start from, when its pose means something.
   std::optional<Eigen::Isometry3d> priorFramePose(const MotionPrior& prior) const;

@@ -37,9 +37,9 @@ double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
 // Splits the prior's tracks between its two motions and decides which the scene follows: the
 // motion of the tracks behind, where the two motions' tracks are image neighbours and one's
 // are in front in most pairs (occlusion; undecided when the tracks behind are by median depth
-// half as far as the others or less: the evidence contradicts itself); else the farther tracks' when their median depth is
-// at least `depth_ratio` times the other's and the constant-velocity prediction `predicted`
-// (previous <- current) is not clearly nearer the other; else the motion with more tracks when
+// half as far as the others or less: the evidence contradicts itself); else the farther
+// tracks' when their median depth is at least `depth_ratio` times the other's and the
+// constant-velocity prediction `predicted` (previous <- current) is not clearly nearer the other; else the motion with more tracks when
 // the other has fewer than `lopsided_ratio` times as many, or when it is also the one nearer
 // the prediction; else undecided. The prediction speaks only where its distances to the two
 // motions differ by more than twice `prediction_error_px` (its recent error, px on the tracks;
