@@ -33,4 +33,23 @@ class CameraModel {
   std::array<double, 8> k_{};  // k1 k2 p1 p2 k3 k4 k5 k6, zeros where absent
 };
 
+// Inline: the photometric stage projects every point each iteration.
+inline Eigen::Vector2d CameraModel::project(const Eigen::Vector3d& p) const {
+  const double x = p.x() / p.z(), y = p.y() / p.z();
+  const double r2 = x * x + y * y;
+  const double radial = (1.0 + r2 * (k_[0] + r2 * (k_[1] + r2 * k_[4]))) /
+                        (1.0 + r2 * (k_[5] + r2 * (k_[6] + r2 * k_[7])));
+  const double xd = x * radial + 2.0 * k_[2] * x * y + k_[3] * (r2 + 2.0 * x * x);
+  const double yd = y * radial + k_[2] * (r2 + 2.0 * y * y) + 2.0 * k_[3] * x * y;
+  return {fx_ * xd + cx_, fy_ * yd + cy_};
+}
+
+inline Eigen::Matrix<double, 2, 3> CameraModel::pinholeJacobian(const Eigen::Vector3d& p) const {
+  const double inv_z = 1.0 / p.z();
+  Eigen::Matrix<double, 2, 3> J;
+  J << fx_ * inv_z, 0.0, -fx_ * p.x() * inv_z * inv_z, 0.0, fy_ * inv_z,
+      -fy_ * p.y() * inv_z * inv_z;
+  return J;
+}
+
 }  // namespace cvo
