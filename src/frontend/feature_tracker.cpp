@@ -31,6 +31,15 @@ constexpr int kBackwardLevels = 1;
 constexpr double kCornerQuality = 0.01;
 // Fewest RANSAC inliers a PnP motion is taken with.
 constexpr std::size_t kMinPnpInliers = 6;
+// RANSAC's iterations at most: the first motion's, and the second's, which searches the first
+// one's outliers. Where an object moves its tracks are most of those and a sample of them comes
+// early; where nothing moves they are noise and the search runs to its cap (at 100: 4 ms a KITTI
+// frame, 3.5 ms a TUM one, half the feature prior's time). At 50, bench/dynamic_table.sh's cases
+// (--extra, strides 1 and 2, with and without labels) gave the same totals of tracked, lost and
+// silent frames and error as the search at 100 with the outliers in reverse order, i.e. as
+// another draw of its random samples; at 30 more silent frames and error.
+constexpr int kFirstMotionIterations = 100;
+constexpr int kSecondMotionIterations = 50;
 
 // A second motion is apart from the first in depth when its tracks' median depth miss is
 // further from the first's tracks' than this many spreads of a median of as many misses ...
@@ -59,16 +68,17 @@ double depthMiss(const cv::Mat& depth, const cv::Point2f& pixel, const cv::Point
 }
 
 // current <- previous from tracks (the previous frame's points, the current image's normalised
-// rays) by EPnP in RANSAC with the inlier threshold `threshold` (normalised units), refined by
-// Levenberg-Marquardt on the inliers; none when RANSAC finds too few.
+// rays) by EPnP in RANSAC (at most `iterations`) with the inlier threshold `threshold`
+// (normalised units), refined by Levenberg-Marquardt on the inliers; none when RANSAC finds too
+// few.
 std::optional<Eigen::Isometry3d> solvePnp(const std::vector<cv::Point3f>& points,
                                           const std::vector<cv::Point2f>& observed,
-                                          double threshold) {
+                                          double threshold, int iterations) {
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
   const cv::Matx33d identity = cv::Matx33d::eye();
   const bool solved =
-      cv::solvePnPRansac(points, observed, identity, cv::noArray(), rvec, tvec, false, 100,
+      cv::solvePnPRansac(points, observed, identity, cv::noArray(), rvec, tvec, false, iterations,
                          static_cast<float>(threshold), 0.999, inliers, cv::SOLVEPNP_EPNP);
   if (!solved || inliers.size() < kMinPnpInliers) return std::nullopt;
   std::vector<cv::Point3f> inlier_points;
@@ -365,9 +375,9 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
       scene_points.push_back(points[k]);
       scene_observed.push_back(observed[k]);
     }
-    first = solvePnp(scene_points, scene_observed, threshold);
+    first = solvePnp(scene_points, scene_observed, threshold, kFirstMotionIterations);
   }
-  if (!first) first = solvePnp(points, observed, threshold);
+  if (!first) first = solvePnp(points, observed, threshold, kFirstMotionIterations);
   if (!first) {
     prior.problem = "PnP found no consistent motion";
     return prior;
@@ -415,7 +425,8 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   // view. Its motion and its tracks' pixels let the odometry judge which one the scene follows
   // and leave the other's region out.
   if (rest_points.size() < kMinTracks) return prior;
-  const std::optional<Eigen::Isometry3d> second = solvePnp(rest_points, rest_observed, threshold);
+  const std::optional<Eigen::Isometry3d> second =
+      solvePnp(rest_points, rest_observed, threshold, kSecondMotionIterations);
   if (!second || !second->matrix().allFinite()) return prior;
   MotionPrior::SecondMotion& out = prior.second;
   std::vector<bool> on_second(points.size(), false);
