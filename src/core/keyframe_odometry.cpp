@@ -146,6 +146,25 @@ void KeyframeOdometry::checkStamp(double stamp) const {
   }
 }
 
+Eigen::Isometry3d KeyframeOdometry::gapToTracks(
+    const MotionPrior& prior, const Eigen::Isometry3d& reference_from_current) const {
+  // The tracks' points are the prior frame's: their motion is prior <- current.
+  const Eigen::Isometry3d prior_from_reference = prior_frame_pose_.inverse() * reference_pose_;
+  return prior.motion.inverse() * prior_from_reference * reference_from_current;
+}
+
+std::string KeyframeOdometry::recoveredPoseProblem(
+    const MotionPrior& prior, const Eigen::Isometry3d& reference_from_current) const {
+  const double gap = gapToTracks(prior, reference_from_current).translation().norm();
+  const double step = prior.motion.translation().norm();
+  if (gap <= std::max(kRecoveredGapFloor, kRecoveredGapShare * step)) return "";
+  std::ostringstream why;
+  why.precision(3);
+  why << "its translation is " << 1000.0 * gap << " mm from the feature tracks' motion ("
+      << 1000.0 * step << " mm a step) > " << kRecoveredGapShare << " of it";
+  return why.str();
+}
+
 bool KeyframeOdometry::movedLately(double stamp) const {
   return moving_seen_stamp_ && stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
 }
@@ -513,8 +532,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     a.track_flow_px = agreement.median_flow_px;
     // The tracks fix rotation well whatever the depth: the final pose's turn over the step
     // against theirs.
-    a.track_rotation_gap_deg =
-        angleDeg(frame.prior->motion.inverse() * prior_from_reference * a.result.transform);
+    a.track_rotation_gap_deg = angleDeg(gapToTracks(*frame.prior, a.result.transform));
     // Beside something moving the dense stages may be pulled a little off the tracks, too
     // little for the pixel bound yet enough for a wrong pose: more of the tracks must agree.
     const bool moving_lately = movedLately(frame.stamp);
@@ -707,22 +725,8 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
       Attempt a = attempt(*cloud, guess, frame, update.dt);
       ++update.attempts;
       if (a.good && frame.prior && frame.prior->solved) {
-        // Both motions over the step from the tracks' frame, as attempt() relates them.
-        const Eigen::Isometry3d prior_from_reference =
-            prior_frame_pose_.inverse() * reference_pose_;
-        const double gap =
-            (frame.prior->motion.inverse() * prior_from_reference * a.result.transform)
-                .translation()
-                .norm();
-        const double step = frame.prior->motion.translation().norm();
-        if (!(gap <= std::max(kRecoveredGapFloor, kRecoveredGapShare * step))) {
-          std::ostringstream why;
-          why.precision(3);
-          why << "its translation is " << 1000.0 * gap << " mm from the feature tracks' motion ("
-              << 1000.0 * step << " mm a step) > " << kRecoveredGapShare << " of it";
-          a.good = false;
-          a.problems = why.str();
-        }
+        std::string problem = recoveredPoseProblem(*frame.prior, a.result.transform);
+        if (!problem.empty()) a.good = false, a.problems = std::move(problem);
       }
       problems += "; to the last good frame: " + a.problems;
       if (a.good) chosen = std::move(a), update.state = TrackingState::kRecovered;

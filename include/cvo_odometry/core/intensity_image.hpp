@@ -64,12 +64,15 @@ class IntensityImage {
   CameraModel camera_;
   std::vector<Level> levels_;
   std::vector<std::uint8_t> excluded_;
+
+  // Bilinear interpolation of a 2x2 block of values (top-left, top-right, bottom-left,
+  // bottom-right): a weighs the right column, b the bottom row.
+  static double bilinear(float top_left, float top_right, float bottom_left, float bottom_right,
+                         double a, double b);
 };
 
-// Bilinear interpolation of a 2x2 block of values (top-left, top-right, bottom-left,
-// bottom-right): a weighs the right column, b the bottom row.
-inline double bilinear(float top_left, float top_right, float bottom_left, float bottom_right,
-                       double a, double b) {
+inline double IntensityImage::bilinear(float top_left, float top_right, float bottom_left,
+                                       float bottom_right, double a, double b) {
   return (1.0 - b) * ((1.0 - a) * top_left + a * top_right) +
          b * ((1.0 - a) * bottom_left + a * bottom_right);
 }

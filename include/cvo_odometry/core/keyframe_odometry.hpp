@@ -212,6 +212,13 @@ class KeyframeOdometry {
   Eigen::Isometry3d stillMotion() const;  // reference <- previous frame
   // start <- the frame the prior's tracks start from, when its pose means something.
   std::optional<Eigen::Isometry3d> priorFramePose(const MotionPrior& prior) const;
+  // The pose `reference_from_current` against the prior's tracks' motion over the same step
+  // (tracks' frame <- current, composed with the motion's inverse): identity where they agree.
+  Eigen::Isometry3d gapToTracks(const MotionPrior& prior,
+                                const Eigen::Isometry3d& reference_from_current) const;
+  // Why a pose recovered against the last good frame is not trusted; empty when it is.
+  std::string recoveredPoseProblem(const MotionPrior& prior,
+                                   const Eigen::Isometry3d& reference_from_current) const;
   void accept(OdometryUpdate& update, Attempt& chosen, const OdometryFrame& frame);
   bool wantsKeyframe(const OdometryUpdate& update) const;
   // `cloud` becomes the reference at the current pose; none when it is missing or has fewer

@@ -39,11 +39,12 @@ double motionsApartPx(const MotionPrior& prior, const Eigen::Isometry3d& a,
 // are in front in most pairs (occlusion; undecided when the tracks behind are by median depth
 // half as far as the others or less: the evidence contradicts itself); else the farther
 // tracks' when their median depth is at least `depth_ratio` times the other's and the
-// constant-velocity prediction `predicted` (previous <- current) is not clearly nearer the other; else the motion with more tracks when
-// the other has fewer than `lopsided_ratio` times as many, or when it is also the one nearer
-// the prediction; else undecided. The prediction speaks only where its distances to the two
-// motions differ by more than twice `prediction_error_px` (its recent error, px on the tracks;
-// 0: unknown). Requires prior.second.solved.
+// constant-velocity prediction `predicted` (previous <- current) is not clearly nearer the
+// other; else the motion with more tracks when the other has fewer than `lopsided_ratio` times
+// as many, or when it is also the one nearer the prediction; else undecided. The prediction
+// speaks only where its distances to the two motions differ by more than twice
+// `prediction_error_px` (its recent error, px on the tracks; 0: unknown). Requires
+// prior.second.solved.
 MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
                          const std::optional<Eigen::Isometry3d>& predicted,
                          double prediction_error_px = 0.0);
