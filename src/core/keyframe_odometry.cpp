@@ -229,6 +229,15 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
           kSpreadApartFactor * params().moving_min_px) {
     return "";
   }
+  if (thirdMotionSeparate(*frame.prior, params().min_prior_inliers, params().moving_min_px)) {
+    // Two objects besides the scene: the two-motion evidence cannot say which is the scene's.
+    std::ostringstream why;
+    why << "tracks split between three motions (" << frame.prior->inliers << ", "
+        << frame.prior->second.inliers << " and " << frame.prior->third.inliers << " tracks)";
+    split_ = MotionSplit{};
+    split_->why = why.str();
+    return split_->why;
+  }
   // The camera's last velocity predicts this step (previous <- current).
   std::optional<Eigen::Isometry3d> predicted;
   const double from =

@@ -195,6 +195,16 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
   return split;
 }
 
+bool thirdMotionSeparate(const MotionPrior& prior, int min_tracks, double moving_min_px) {
+  // At 1x moving_min_px more frames of one object were lost to the scene's spread; at 2x two
+  // objects passing each other gave silent failures.
+  constexpr double kApartFactor = 1.5;
+  const double apart = kApartFactor * moving_min_px;
+  return prior.third.solved && prior.third.inliers >= min_tracks &&
+         motionsApartPx(prior, prior.motion, prior.third.motion) >= apart &&
+         motionsApartPx(prior, prior.second.motion, prior.third.motion) >= apart;
+}
+
 MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split) {
   MotionPrior out = prior;
   const bool swap = split.scene == SceneMotion::kSecond;

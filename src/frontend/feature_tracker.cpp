@@ -16,6 +16,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "cvo_odometry/core/labeled_cloud.hpp"
+#include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/robust_scale.hpp"
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
@@ -32,7 +33,7 @@ constexpr double kCornerQuality = 0.01;
 // Fewest RANSAC inliers a PnP motion is taken with.
 constexpr std::size_t kMinPnpInliers = 6;
 // RANSAC's iterations at most: the first motion's, and the second's, which searches the first
-// one's outliers. Where an object moves its tracks are most of those and a sample of them comes
+// one's outliers (and the third's, the outliers of both). Where an object moves its tracks are most of those and a sample of them comes
 // early; where nothing moves they are noise and the search runs to its cap (at 100: 4 ms a KITTI
 // frame, 3.5 ms a TUM one, half the feature prior's time). At 50, bench/dynamic_table.sh's cases
 // (--extra, strides 1 and 2, with and without labels) gave the same totals of tracked, lost and
@@ -122,7 +123,8 @@ void FeatureTrackerOptions::validate() const {
     throw std::invalid_argument("feature_corners must be >= " + std::to_string(kMinTracks));
   }
   if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
-      !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000) {
+      !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000 ||
+      !(third_motion_after_px >= 0.0)) {
     throw std::invalid_argument("feature tracker options make no sense");
   }
 }
@@ -451,6 +453,12 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   }
   out.motion = second->inverse();
   if (!out.solved) return prior;
+  // Only beside a second motion apart enough to be an object's (KeyframeOdometry judges it the
+  // same way): on a still scene the search would run to its cap on noise, 2 ms a frame.
+  if (motionsApartPx(prior, prior.motion, out.motion) >= options_.third_motion_after_px) {
+    solveThirdMotion(current, points, observed, from_pixels, track_errors, on_second,
+                     current_from_previous, threshold, &prior);
+  }
   // Apart in depth: the second motion's tracks' depth misses (measured in the current frame
   // against the first motion's prediction) have a median far outside what the first motion's
   // own tracks' misses allow a median of as many. TUM with a board approaching from 1.2 m
@@ -487,6 +495,51 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   }
   out.apart_in_depth = 2 * again >= static_cast<std::size_t>(out.inliers);
   return prior;
+}
+
+void FeatureTracker::solveThirdMotion(const std::vector<cv::Mat>& current,
+                                      const std::vector<cv::Point3f>& points,
+                                      const std::vector<cv::Point2f>& observed,
+                                      const std::vector<cv::Point2f>& from_pixels,
+                                      const std::vector<float>& track_errors,
+                                      const std::vector<bool>& on_second,
+                                      const Eigen::Isometry3d& first, double threshold,
+                                      MotionPrior* prior) const {
+  // The tracks neither motion puts within the inlier distance.
+  std::vector<cv::Point3f> rest_points;
+  std::vector<cv::Point2f> rest_observed;
+  std::vector<std::size_t> rest_index;  // into points
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (on_second[k]) continue;
+    const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
+    if (reprojects(first, X, Eigen::Vector2d(observed[k].x, observed[k].y), threshold)) continue;
+    rest_points.push_back(points[k]);
+    rest_observed.push_back(observed[k]);
+    rest_index.push_back(k);
+  }
+  if (rest_points.size() < kMinTracks) return;
+  const std::optional<Eigen::Isometry3d> third =
+      solvePnp(rest_points, rest_observed, threshold, kSecondMotionIterations);
+  if (!third || !third->matrix().allFinite()) return;
+  std::vector<bool> on_third(points.size(), false);
+  int inliers = 0;
+  for (std::size_t i = 0; i < rest_points.size(); ++i) {
+    const Eigen::Vector3d X(rest_points[i].x, rest_points[i].y, rest_points[i].z);
+    if (!reprojects(*third, X, Eigen::Vector2d(rest_observed[i].x, rest_observed[i].y),
+                    threshold)) {
+      continue;
+    }
+    on_third[rest_index[i]] = true;
+    ++inliers;
+  }
+  if (inliers < static_cast<int>(kMinPnpInliers)) return;
+  // Mostly slipped tracks: a repeating texture, as for the second motion.
+  const std::vector<bool> slipped = slippedTracks(current, points, from_pixels, track_errors,
+                                                  on_third, first, prior->camera);
+  if (std::count(slipped.begin(), slipped.end(), true) >= kSlippedShare * inliers) return;
+  prior->third.solved = true;
+  prior->third.motion = third->inverse();
+  prior->third.inliers = inliers;
 }
 
 std::vector<bool> FeatureTracker::slippedTracks(const std::vector<cv::Mat>& current,

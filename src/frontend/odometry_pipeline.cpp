@@ -52,7 +52,7 @@ OdometryPipeline::OdometryPipeline(const OdometrySettings& settings, BackendFact
   resetGovernor();
   rgbd_builder_ = std::make_unique<RgbdCloudBuilder>(settings_.rgbdOptions());
   stereo_builder_ = std::make_unique<StereoCloudBuilder>(settings_.stereoOptions());
-  tracker_ = std::make_unique<FeatureTracker>(settings_.features);
+  tracker_ = std::make_unique<FeatureTracker>(settings_.trackerOptions());
   offset_calibration_ = makeOffsetCalibration(settings_);
 }
 
@@ -78,7 +78,7 @@ bool OdometryPipeline::setSettings(const OdometrySettings& settings) {
   // Build everything new first: a refusal leaves the pipeline as it was.
   auto rgbd = std::make_unique<RgbdCloudBuilder>(settings.rgbdOptions());
   auto stereo = std::make_unique<StereoCloudBuilder>(settings.stereoOptions());
-  auto tracker = std::make_unique<FeatureTracker>(settings.features);
+  auto tracker = std::make_unique<FeatureTracker>(settings.trackerOptions());
   const bool new_backend = settings.cvo.backend != settings_.cvo.backend ||
                            settings.cvo.num_threads != settings_.cvo.num_threads;
   const bool new_governor =

@@ -42,6 +42,12 @@ StereoFrontendOptions OdometrySettings::stereoOptions() const {
   return options;
 }
 
+FeatureTrackerOptions OdometrySettings::trackerOptions() const {
+  FeatureTrackerOptions options = features;
+  options.third_motion_after_px = cvo.moving_min_px;
+  return options;
+}
+
 OdometrySettings loadOdometrySettings(const std::string& path, const OdometrySettings& base) {
   OdometrySettings settings = base;
   if (path.empty()) {

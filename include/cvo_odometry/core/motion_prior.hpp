@@ -58,6 +58,14 @@ struct MotionPrior {
     // the image may not tell the motions apart: an object moving along the view's rays.
     bool apart_in_depth = false;
   } second;
+  // A third motion among the tracks neither of those explains: two objects moving through the
+  // view (people walking past each other), and which of three motions the scene follows is more
+  // than the two-motion evidence (motion_split.hpp) can tell.
+  struct ThirdMotion {
+    bool solved = false;
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current
+    int inliers = 0;
+  } third;
   double focal_px = 0.0;  // pixels per normalised unit: converts errors to pixels
   std::string problem;    // why no motion was solved
   double time_ms = 0.0;   // tracking and solving, on the caller's thread

@@ -49,6 +49,13 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
                          const std::optional<Eigen::Isometry3d>& predicted,
                          double prediction_error_px = 0.0);
 
+// The prior's third motion (MotionPrior::third) is one of its own: `min_tracks` tracks, moving
+// them at least 1.5 x `moving_min_px` from where each of the other two motions puts them. A
+// nearer one is read as that motion's own spread: a scene's near and far tracks under an RGB-D
+// camera's depth lag came 2.5-6 px apart beside an object's motion (bench/dynamic_table.sh's
+// cases, strides 1-3).
+bool thirdMotionSeparate(const MotionPrior& prior, int min_tracks, double moving_min_px);
+
 // The prior as the scene sees it: the scene's motion first, its own tracks alone as the inliers
 // (those the other motion explains better left out), the other motion second with its own.
 MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split);

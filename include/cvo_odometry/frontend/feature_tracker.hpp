@@ -35,6 +35,10 @@ struct FeatureTrackerOptions {
   // fewer of the tracks than it would (a third of TUM's view: 55-62 % of them, against over
   // 90 % unspread).
   int grid_columns = 8;
+  // A third motion is searched among the tracks the first two leave out only where the second
+  // moves the tracks at least this far (px) from the first (OdometrySettings::trackerOptions:
+  // moving_min_px); 0: wherever a second motion is solved.
+  double third_motion_after_px = 0.0;
 
   void validate() const;
 };
@@ -109,9 +113,9 @@ class FeatureTracker {
   // The prior from the anchor's corners tracked into `current` (the current frame's pyramid;
   // `depth` its depth image, CV_32FC1, or empty). `depth_shifted`: where the second motion's
   // tracks' depths missed the first's (none when they did not).
-  MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Mat& depth,
-                    const cv::Size& size, const PinholeIntrinsics& intrinsics,
-                    const cv::Mat& excluded, std::vector<cv::Point2f>* depth_shifted) const;
+  MotionPrior solve(const std::vector<cv::Mat>& current, const cv::Mat& depth, const cv::Size& size,
+                    const PinholeIntrinsics& intrinsics, const cv::Mat& excluded,
+                    std::vector<cv::Point2f>* depth_shifted) const;
   // Per track of `which` (`points` seen at `from_pixels`, with KLT's `track_errors`): true where
   // KLT, started where `current_from_previous` puts it, settles there too with a patch about as
   // alike as its own track's (a repeating texture).
@@ -122,6 +126,14 @@ class FeatureTracker {
                                   const std::vector<bool>& which,
                                   const Eigen::Isometry3d& current_from_previous,
                                   const std::optional<CameraModel>& camera) const;
+  // prior->third from the tracks (`points` seen at `observed`, normalised) that neither `first`
+  // (current <- previous) nor the second motion (`on_second`: its inliers) explains within
+  // `threshold`.
+  void solveThirdMotion(const std::vector<cv::Mat>& current, const std::vector<cv::Point3f>& points,
+                        const std::vector<cv::Point2f>& observed,
+                        const std::vector<cv::Point2f>& from_pixels,
+                        const std::vector<float>& track_errors, const std::vector<bool>& on_second,
+                        const Eigen::Isometry3d& first, double threshold, MotionPrior* prior) const;
 
   FeatureTrackerOptions options_;
   MinEigenCorners corners_;         // used by seed() only

@@ -36,6 +36,8 @@ struct OdometrySettings {
   CloudBuilderOptions cloudOptions() const;
   RgbdFrontendOptions rgbdOptions() const;
   StereoFrontendOptions stereoOptions() const;
+  // The feature tracker's: `features`, with what the odometry takes for an object's motion.
+  FeatureTrackerOptions trackerOptions() const;
 };
 
 template <class V>
