@@ -3,7 +3,8 @@
 // Writes a folder the runner and cvo_make_bag read like the original (TUM: rgb/, depth/,
 // associations.txt, groundtruth.txt; KITTI: image_0/, image_1/, calib.txt, times.txt, poses.txt),
 // the labels below labels/ (8-bit: the object's class, 0 elsewhere) and object.txt (per frame:
-// the share of the image it covers and how far its centre moved, px).
+// the share of the image it covers and how far its centre moved, px). Made from such a folder,
+// the objects before keep their labels where the new one leaves them in view.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -29,7 +30,8 @@ namespace fs = std::filesystem;
 const char* kUsage =
     "usage: cvo_make_dynamic (--tum DIR | --kitti DIR) --out DIR [object options]\n"
     "  a moving textured board composited into every frame, with its labels in OUT/labels\n"
-    "  (run with --segmentation OUT/labels --semantic-classes 2 --ignore-classes 1)\n"
+    "  (run with --segmentation OUT/labels --semantic-classes 2 --ignore-classes 1); made from\n"
+    "  such a folder, a second object, the first one's labels kept where it leaves them in view\n"
     "  --area F            share of the image it covers in the first frame (0.3)\n"
     "  --aspect A          width / height (0.75)\n"
     "  --depth Z           metres from the first camera (0.6)\n"
@@ -94,6 +96,19 @@ Eigen::Isometry3d poseAt(const cvo::Trajectory& truth, double stamp, double max_
 void writeImage(const fs::path& path, const cv::Mat& image) {
   fs::create_directories(path.parent_path());
   if (!cv::imwrite(path.string(), image)) throw std::runtime_error("cannot write " + path.string());
+}
+
+// The frame's labels: those of the objects composited before (`earlier`, the source folder's
+// labels, when it has them) where the new object does not cover them, and the new one's.
+cv::Mat withEarlierLabels(const fs::path& earlier, const cv::Mat& labels, const cv::Mat& covered) {
+  if (!fs::exists(earlier)) return labels;
+  cv::Mat out = cv::imread(earlier.string(), cv::IMREAD_UNCHANGED);
+  if (out.type() != CV_8UC1 || out.size() != labels.size()) {
+    throw std::runtime_error(earlier.string() + ": not an 8-bit label image of the frames' size");
+  }
+  if (!covered.empty()) out.setTo(0, covered);
+  labels.copyTo(out, labels);
+  return out;
 }
 
 cvo::MovingObjectSpec specFrom(const cvo::CommandLine& cli) {
@@ -168,7 +183,9 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
     const std::string depth_listed = relativeTo(folder, f.depth_path);
     writeImage(out / f.rgb_listed, image);
     writeImage(out / depth_listed, depth);
-    writeImage(out / "labels" / f.rgb_listed, object.labels(mask));
+    writeImage(out / "labels" / f.rgb_listed,
+               withEarlierLabels(fs::path(folder) / "labels" / f.rgb_listed, object.labels(mask),
+                                 labels_only ? cv::Mat() : mask));
     associations << std::fixed << std::setprecision(6) << f.rgb_stamp << " " << f.rgb_listed << " "
                  << f.depth_stamp << " " << depth_listed << "\n";
     rgb_list << std::fixed << std::setprecision(6) << f.rgb_stamp << " " << f.rgb_listed << "\n";
@@ -219,7 +236,9 @@ void makeKitti(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, c
     const std::string name = sequence.imageName(k);
     writeImage(out / "image_0" / name, left);
     writeImage(out / "image_1" / name, right);
-    writeImage(out / "labels" / "image_0" / name, object.labels(mask));
+    writeImage(out / "labels" / "image_0" / name,
+               withEarlierLabels(fs::path(folder) / "labels" / "image_0" / name,
+                                 object.labels(mask), labels_only ? cv::Mat() : mask));
     summary->add(stamp, mask);
   }
   for (const char* file : {"calib.txt", "times.txt", "poses.txt"}) {
