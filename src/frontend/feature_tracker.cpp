@@ -33,9 +33,10 @@ constexpr double kCornerQuality = 0.01;
 // Fewest RANSAC inliers a PnP motion is taken with.
 constexpr std::size_t kMinPnpInliers = 6;
 // RANSAC's iterations at most: the first motion's, and the second's, which searches the first
-// one's outliers (and the third's, the outliers of both). Where an object moves its tracks are most of those and a sample of them comes
-// early; where nothing moves they are noise and the search runs to its cap (at 100: 4 ms a KITTI
-// frame, 3.5 ms a TUM one, half the feature prior's time). At 50, bench/dynamic_table.sh's cases
+// one's outliers (and the third's, the outliers of both). Where an object moves its tracks are
+// most of those and a sample of them comes early; where nothing moves they are noise and the
+// search runs to its cap (at 100: 4 ms a KITTI frame, 3.5 ms a TUM one, half the feature prior's
+// time). At 50, bench/dynamic_table.sh's cases
 // (--extra, strides 1 and 2, with and without labels) gave the same totals of tracked, lost and
 // silent frames and error as the search at 100 with the outliers in reverse order, i.e. as
 // another draw of its random samples; at 30 more silent frames and error.
