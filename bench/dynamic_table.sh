@@ -58,7 +58,7 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# name|dataset|cvo_make_dynamic options ("A + B": a second object composited over the first).
+# name|dataset|cvo_make_dynamic options ("A + B": B composited over A, so B is the nearer one).
 # TUM fr1_xyz: the camera moves 0.37 m forward over the 37 frames, so a board that should stay
 # 0.5-0.7 m away walks away from it at 0.2 m/s.
 tum_cases=(
@@ -89,7 +89,7 @@ if $more_cases; then
     "near: a fifth at 0.4 m, ellipse|tum|--area 0.2 --depth 0.4 --velocity 0.3,0,0 --start 0.2,0.5 --shape ellipse"
     "scene along: the scene's texture, with the camera|tum|--area 0.25 --depth 0.6 --with-camera --velocity 0.1,0,0 --start 0.3,0.55 --texture scene"
     "labels 6 px over: person|tum|--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --label-error -6"
-    "two: a third across, a fifth back|tum|--area 0.3 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 + --area 0.2 --depth 0.8 --velocity -0.3,0,0.25 --start 0.8,0.5 --texture checker --seed 5"
+    "two: a fifth back, a third across in front|tum|--area 0.2 --depth 0.8 --velocity -0.3,0,0.25 --start 0.8,0.5 --texture checker --seed 5 + --area 0.3 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5"
   )
 fi
 kitti_cases=()
@@ -107,7 +107,7 @@ if $more_cases; then
     "car crossing 15 m ahead, leftward|kitti|--area 0.12 --depth 15 --velocity -6,0,0 --start 0.7,0.6"
     "oncoming car from 25 m|kitti|--area 0.08 --depth 25 --velocity 0,0,-8 --start 0.4,0.6"
     "checkered truck along, leftward|kitti|--area 0.3 --depth 8 --with-camera --velocity -1,0,0 --start 0.55,0.6 --texture checker"
-    "two: van along, car crossing|kitti|--area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6 + --area 0.08 --depth 15 --velocity -6,0,0 --start 0.7,0.6 --seed 5"
+    "two: a car crossing, a van along in front|kitti|--area 0.08 --depth 15 --velocity -6,0,0 --start 0.7,0.6 --seed 5 + --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6"
   )
 fi
 
@@ -152,16 +152,17 @@ rows=()
 run_case() {
   local name=$1 kind=$2 options=$3 dir=$work/case
   rm -rf "$dir"
-  local source=$tum gt object objects=0
+  local source=$tum gt object_options objects=0
   [ "$kind" = kitti ] && source=$kitti
+  [ -n "$options" ] || { echo "dynamic_table: $name: no object" >&2; exit 2; }
   # One object after the other, each made from the folder with those before it.
   while [ -n "$options" ]; do
-    object=${options%% + *}
-    if [ "$object" = "$options" ]; then options=; else options=${options#* + }; fi
+    object_options=${options%% + *}
+    if [ "$object_options" = "$options" ]; then options=; else options=${options#* + }; fi
     objects=$((objects + 1))
     rm -rf "$dir.$objects"
     # shellcheck disable=SC2086  # the options are words
-    "$bin/cvo_make_dynamic" "--$kind" "$source" --out "$dir.$objects" $object \
+    "$bin/cvo_make_dynamic" "--$kind" "$source" --out "$dir.$objects" $object_options \
       >"$work/make.log" 2>&1 || { cat "$work/make.log" >&2; exit 1; }
     source=$dir.$objects
     # The share and motion columns: the first object's.

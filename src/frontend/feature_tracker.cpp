@@ -32,14 +32,13 @@ constexpr int kBackwardLevels = 1;
 constexpr double kCornerQuality = 0.01;
 // Fewest RANSAC inliers a PnP motion is taken with.
 constexpr std::size_t kMinPnpInliers = 6;
-// RANSAC's iterations at most: the first motion's, and the second's, which searches the first
-// one's outliers (and the third's, the outliers of both). Where an object moves its tracks are
-// most of those and a sample of them comes early; where nothing moves they are noise and the
-// search runs to its cap (at 100: 4 ms a KITTI frame, 3.5 ms a TUM one, half the feature prior's
-// time). At 50, bench/dynamic_table.sh's cases
-// (--extra, strides 1 and 2, with and without labels) gave the same totals of tracked, lost and
-// silent frames and error as the search at 100 with the outliers in reverse order, i.e. as
-// another draw of its random samples; at 30 more silent frames and error.
+// RANSAC's iterations at most: the first motion's, and the second's, which searches the first one's
+// outliers (and the third's, the outliers of both). Where an object moves its tracks are most of
+// those and a sample of them comes early; where nothing moves they are noise and the search runs to
+// its cap (at 100: 4 ms a KITTI frame, 3.5 ms a TUM one, half the feature prior's time). At 50,
+// bench/dynamic_table.sh's cases (--extra, strides 1 and 2, with and without labels) gave the same
+// totals of tracked, lost and silent frames and error as the search at 100 with the outliers in
+// reverse order, i.e. as another draw of its random samples; at 30 more silent frames and error.
 constexpr int kFirstMotionIterations = 100;
 constexpr int kSecondMotionIterations = 50;
 
@@ -125,7 +124,7 @@ void FeatureTrackerOptions::validate() const {
   }
   if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
       !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000 ||
-      !(third_motion_after_px >= 0.0)) {
+      !(object_apart_px >= 0.0)) {
     throw std::invalid_argument("feature tracker options make no sense");
   }
 }
@@ -454,9 +453,9 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   }
   out.motion = second->inverse();
   if (!out.solved) return prior;
-  // Only beside a second motion apart enough to be an object's (KeyframeOdometry judges it the
-  // same way): on a still scene the search would run to its cap on noise, 2 ms a frame.
-  if (motionsApartPx(prior, prior.motion, out.motion) >= options_.third_motion_after_px) {
+  // Only beside a second motion moving_min_px from the first (KeyframeOdometry's test in the
+  // image): on a still scene the search would run to its cap on noise, 2 ms a frame.
+  if (motionsApartPx(prior, prior.motion, out.motion) >= options_.object_apart_px) {
     solveThirdMotion(current, points, observed, from_pixels, track_errors, on_second,
                      current_from_previous, threshold, &prior);
   }

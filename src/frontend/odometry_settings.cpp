@@ -44,7 +44,7 @@ StereoFrontendOptions OdometrySettings::stereoOptions() const {
 
 FeatureTrackerOptions OdometrySettings::trackerOptions() const {
   FeatureTrackerOptions options = features;
-  options.third_motion_after_px = cvo.moving_min_px;
+  options.object_apart_px = cvo.moving_min_px;
   return options;
 }
 

@@ -174,6 +174,8 @@ struct CvoParams {
   // region closes gaps of up to 4x moving_region_px: at 24 px it also took the scene between a
   // board and the image's border and the edges of a monitor beside it (TUM, a checkerboard a
   // third of the view: 63 % of the points left out, 25 of 36 frames lost); 14-20 px keep 34-36.
+  // A third motion 1.5 moving_min_px from both others (two objects) loses the frame
+  // (thirdMotionSeparate); the tracker searches one only beside a second moving_min_px apart.
   double moving_min_px = 4.0;
   double moving_region_px = 16.0;
   double motion_split_ratio = 0.3;

@@ -35,10 +35,10 @@ struct FeatureTrackerOptions {
   // fewer of the tracks than it would (a third of TUM's view: 55-62 % of them, against over
   // 90 % unspread).
   int grid_columns = 8;
-  // A third motion is searched among the tracks the first two leave out only where the second
-  // moves the tracks at least this far (px) from the first (OdometrySettings::trackerOptions:
-  // moving_min_px); 0: wherever a second motion is solved.
-  double third_motion_after_px = 0.0;
+  // A second motion that moves the tracks at least this far (px) from the first is an object's
+  // (OdometrySettings::trackerOptions: moving_min_px); only beside one is a third motion searched
+  // among the tracks the first two leave out. 0: beside every second motion.
+  double object_apart_px = 0.0;
 
   void validate() const;
 };
