@@ -116,6 +116,35 @@ bool reprojects(const Eigen::Isometry3d& current_from_previous, const Eigen::Vec
   return p.z() > 1e-6 && (p.head<2>() / p.z() - x).norm() <= threshold;
 }
 
+// A motion of the tracks `among` (indices into `points` and their normalised rays `observed`)
+// by solvePnp, and those of them it puts within `threshold`, in order: the second and third
+// motions, each among the tracks the motions before leave out.
+struct TracksMotion {
+  Eigen::Isometry3d current_from_previous;
+  std::vector<std::size_t> inliers;
+};
+std::optional<TracksMotion> motionAmong(const std::vector<cv::Point3f>& points,
+                                        const std::vector<cv::Point2f>& observed,
+                                        const std::vector<std::size_t>& among, double threshold) {
+  std::vector<cv::Point3f> some_points;
+  std::vector<cv::Point2f> some_observed;
+  for (std::size_t k : among) {
+    some_points.push_back(points[k]);
+    some_observed.push_back(observed[k]);
+  }
+  const std::optional<Eigen::Isometry3d> motion =
+      solvePnp(some_points, some_observed, threshold, kSecondMotionIterations);
+  if (!motion || !motion->matrix().allFinite()) return std::nullopt;
+  TracksMotion out{*motion, {}};
+  for (std::size_t k : among) {
+    const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
+    if (reprojects(*motion, X, Eigen::Vector2d(observed[k].x, observed[k].y), threshold)) {
+      out.inliers.push_back(k);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void FeatureTrackerOptions::validate() const {
@@ -123,8 +152,7 @@ void FeatureTrackerOptions::validate() const {
     throw std::invalid_argument("feature_corners must be >= " + std::to_string(kMinTracks));
   }
   if (!(min_distance > 0.0) || window < 5 || levels < 0 || levels > 8 || !(max_flow_error > 0.0) ||
-      !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000 ||
-      !(object_apart_px >= 0.0)) {
+      !(ransac_px > 0.0) || grid_columns < 0 || grid_columns > 1000 || !(object_apart_px >= 0.0)) {
     throw std::invalid_argument("feature tracker options make no sense");
   }
 }
@@ -401,20 +429,17 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   // The inliers of the refined motion are the tracks that judge CVO.
   prior.tracked_points.reserve(points.size());
   prior.tracked_observations.reserve(points.size());
-  std::vector<cv::Point3f> rest_points;
-  std::vector<cv::Point2f> rest_observed, rest_pixels;
-  std::vector<std::size_t> rest_index;  // into points
+  std::vector<std::size_t> rest;                      // the tracks the first motion leaves out
+  std::vector<bool> off_first(points.size(), false);  // not within its inlier distance
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
     const Eigen::Vector2d x(observed[k].x, observed[k].y);
     prior.tracked_points.push_back(X);
     prior.tracked_observations.push_back(x);
     prior.tracked_pixels.emplace_back(pixels[k].x, pixels[k].y);
-    if ((separate && on_object[k]) || !reprojects(current_from_previous, X, x, threshold)) {
-      rest_points.push_back(points[k]);
-      rest_observed.push_back(observed[k]);
-      rest_pixels.push_back(pixels[k]);
-      rest_index.push_back(k);
+    off_first[k] = !reprojects(current_from_previous, X, x, threshold);
+    if ((separate && on_object[k]) || off_first[k]) {
+      rest.push_back(k);
       continue;
     }
     prior.points.push_back(X);
@@ -426,21 +451,15 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   // The tracks it leaves out may follow one motion of their own: an object moving through the
   // view. Its motion and its tracks' pixels let the odometry judge which one the scene follows
   // and leave the other's region out.
-  if (rest_points.size() < kMinTracks) return prior;
-  const std::optional<Eigen::Isometry3d> second =
-      solvePnp(rest_points, rest_observed, threshold, kSecondMotionIterations);
-  if (!second || !second->matrix().allFinite()) return prior;
+  if (rest.size() < kMinTracks) return prior;
+  const std::optional<TracksMotion> second = motionAmong(points, observed, rest, threshold);
+  if (!second) return prior;
   MotionPrior::SecondMotion& out = prior.second;
   std::vector<bool> on_second(points.size(), false);
-  for (std::size_t k = 0; k < rest_points.size(); ++k) {
-    const Eigen::Vector3d X(rest_points[k].x, rest_points[k].y, rest_points[k].z);
-    if (!reprojects(*second, X, Eigen::Vector2d(rest_observed[k].x, rest_observed[k].y),
-                    threshold)) {
-      continue;
-    }
-    out.pixels.emplace_back(rest_pixels[k].x, rest_pixels[k].y);
-    on_second[rest_index[k]] = true;
-    if (separate && on_object[rest_index[k]]) ++out.known_object;
+  for (std::size_t k : second->inliers) {
+    out.pixels.emplace_back(pixels[k].x, pixels[k].y);
+    on_second[k] = true;
+    if (separate && on_object[k]) ++out.known_object;
   }
   out.inliers = static_cast<int>(out.pixels.size());
   out.solved = out.pixels.size() >= kMinPnpInliers;
@@ -451,12 +470,16 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
     // Mostly slipped tracks: a repeating texture, not an object.
     if (prior.slipped >= kSlippedShare * out.inliers) out.solved = false;
   }
-  out.motion = second->inverse();
+  out.motion = second->current_from_previous.inverse();
   if (!out.solved) return prior;
   // Only beside a second motion moving_min_px from the first (KeyframeOdometry's test in the
   // image): on a still scene the search would run to its cap on noise, 2 ms a frame.
   if (motionsApartPx(prior, prior.motion, out.motion) >= options_.object_apart_px) {
-    solveThirdMotion(current, points, observed, from_pixels, track_errors, on_second,
+    std::vector<std::size_t> off_both;  // the tracks neither motion puts within the distance
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (off_first[k] && !on_second[k]) off_both.push_back(k);
+    }
+    solveThirdMotion(current, points, observed, from_pixels, track_errors, off_both,
                      current_from_previous, threshold, &prior);
   }
   // Apart in depth: the second motion's tracks' depth misses (measured in the current frame
@@ -497,48 +520,24 @@ MotionPrior FeatureTracker::solve(const std::vector<cv::Mat>& current, const cv:
   return prior;
 }
 
-void FeatureTracker::solveThirdMotion(const std::vector<cv::Mat>& current,
-                                      const std::vector<cv::Point3f>& points,
-                                      const std::vector<cv::Point2f>& observed,
-                                      const std::vector<cv::Point2f>& from_pixels,
-                                      const std::vector<float>& track_errors,
-                                      const std::vector<bool>& on_second,
-                                      const Eigen::Isometry3d& first, double threshold,
-                                      MotionPrior* prior) const {
-  // The tracks neither motion puts within the inlier distance.
-  std::vector<cv::Point3f> rest_points;
-  std::vector<cv::Point2f> rest_observed;
-  std::vector<std::size_t> rest_index;  // into points
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    if (on_second[k]) continue;
-    const Eigen::Vector3d X(points[k].x, points[k].y, points[k].z);
-    if (reprojects(first, X, Eigen::Vector2d(observed[k].x, observed[k].y), threshold)) continue;
-    rest_points.push_back(points[k]);
-    rest_observed.push_back(observed[k]);
-    rest_index.push_back(k);
-  }
-  if (rest_points.size() < kMinTracks) return;
-  const std::optional<Eigen::Isometry3d> third =
-      solvePnp(rest_points, rest_observed, threshold, kSecondMotionIterations);
-  if (!third || !third->matrix().allFinite()) return;
+void FeatureTracker::solveThirdMotion(
+    const std::vector<cv::Mat>& current, const std::vector<cv::Point3f>& points,
+    const std::vector<cv::Point2f>& observed, const std::vector<cv::Point2f>& from_pixels,
+    const std::vector<float>& track_errors, const std::vector<std::size_t>& among,
+    const Eigen::Isometry3d& first, double threshold, MotionPrior* prior) const {
+  if (among.size() < kMinTracks) return;
+  const std::optional<TracksMotion> third = motionAmong(points, observed, among, threshold);
+  if (!third || third->inliers.size() < kMinPnpInliers) return;
   std::vector<bool> on_third(points.size(), false);
-  int inliers = 0;
-  for (std::size_t i = 0; i < rest_points.size(); ++i) {
-    const Eigen::Vector3d X(rest_points[i].x, rest_points[i].y, rest_points[i].z);
-    if (!reprojects(*third, X, Eigen::Vector2d(rest_observed[i].x, rest_observed[i].y),
-                    threshold)) {
-      continue;
-    }
-    on_third[rest_index[i]] = true;
-    ++inliers;
-  }
-  if (inliers < static_cast<int>(kMinPnpInliers)) return;
+  for (std::size_t k : third->inliers)
+    on_third[k] = true;
+  const auto inliers = static_cast<int>(third->inliers.size());
   // Mostly slipped tracks: a repeating texture, as for the second motion.
-  const std::vector<bool> slipped = slippedTracks(current, points, from_pixels, track_errors,
-                                                  on_third, first, prior->camera);
+  const std::vector<bool> slipped =
+      slippedTracks(current, points, from_pixels, track_errors, on_third, first, prior->camera);
   if (std::count(slipped.begin(), slipped.end(), true) >= kSlippedShare * inliers) return;
   prior->third.solved = true;
-  prior->third.motion = third->inverse();
+  prior->third.motion = third->current_from_previous.inverse();
   prior->third.inliers = inliers;
 }
 

@@ -183,8 +183,8 @@ cvo::MovingObjectSpec boardSpec(double area) {
 }
 
 // TUM frames 0..last with the boards of `specs` composited, each over those before it (the
-// nearer last); calls
-// `each` with every frame (colour, grey and depth with the boards) and each board's mask.
+// nearer last); calls `each` with every frame (colour, grey and depth with the boards) and each
+// board's mask.
 void withMovingBoards(
     const std::vector<cvo::MovingObjectSpec>& specs, std::size_t last,
     const std::function<void(std::size_t, const Frame&, const std::vector<cv::Mat>&)>& each) {

@@ -126,14 +126,15 @@ class FeatureTracker {
                                   const std::vector<bool>& which,
                                   const Eigen::Isometry3d& current_from_previous,
                                   const std::optional<CameraModel>& camera) const;
-  // prior->third from the tracks (`points` seen at `observed`, normalised) that neither `first`
-  // (current <- previous) nor the second motion (`on_second`: its inliers) explains within
+  // prior->third from the tracks `among` (indices into `points`, seen at the normalised rays
+  // `observed`): those neither `first` (current <- previous) nor the second motion puts within
   // `threshold`.
   void solveThirdMotion(const std::vector<cv::Mat>& current, const std::vector<cv::Point3f>& points,
                         const std::vector<cv::Point2f>& observed,
                         const std::vector<cv::Point2f>& from_pixels,
-                        const std::vector<float>& track_errors, const std::vector<bool>& on_second,
-                        const Eigen::Isometry3d& first, double threshold, MotionPrior* prior) const;
+                        const std::vector<float>& track_errors,
+                        const std::vector<std::size_t>& among, const Eigen::Isometry3d& first,
+                        double threshold, MotionPrior* prior) const;
 
   FeatureTrackerOptions options_;
   MinEigenCorners corners_;         // used by seed() only
