@@ -221,9 +221,15 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   }
   stale_.accept();
   input.moving_classes_left_out = !images.excluded.empty();
-  if (!settings_.features.enabled || images.grey.empty()) {
+  // A frame with nothing usable (everything masked, say a person right in front of the lens)
+  // leaves the anchor as it is: the next frame is tracked from the last trusted one, whose pose
+  // is known. Anchored on the empty frame, the tracks would relate the next ones to a pose
+  // nobody knows, and a KITTI car lost 5 frames and restarted after a cyclist filled the view.
+  const bool tracks_this_frame =
+      settings_.features.enabled && !images.grey.empty() && input.cloud != nullptr;
+  if (!settings_.features.enabled || (images.grey.empty() && input.cloud != nullptr)) {
     tracker_->reset();  // the prior relates this frame and the next only: none without images
-  } else {
+  } else if (tracks_this_frame) {
     // From the second frame on, the prior (solved, or why not) relates this frame to the last.
     const bool tracked = tracker_->hasPreviousFrame();
     MotionPrior prior = tracker_->track(images.grey, images.depth, intrinsics,
@@ -243,7 +249,7 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   }
   // The next frame is tracked from the last trusted one, telling apart the corners of an object
   // the odometry found moving in it.
-  if (tracker_->hasPreviousFrame()) {
+  if (tracks_this_frame && tracker_->hasPreviousFrame()) {
     tracker_->frameJudged(result.update.trusted() || result.update.restart_tracks,
                           result.update.moving_region);
   }

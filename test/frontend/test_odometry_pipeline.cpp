@@ -113,6 +113,39 @@ TEST(OdometryPipeline, RepeatedImagesAreStaleAndChangeNothingElse) {
   EXPECT_EQ(bursts, 9u) << "one log line per run of stale frames";
 }
 
+// Proves: a frame whose every pixel is of an ignored class (a person right in front of the
+// lens) is lost, and the next frame is tracked from the last trusted one: its feature prior
+// starts there, guesses and judges, and the frame is trusted.
+TEST(OdometryPipeline, AFullyMaskedFrameLeavesTheTracksToTheLastTrustedOne) {
+  const cvo::TumSequence sequence(kTum);
+  cvo::OdometrySettings settings = tumSettings();
+  settings.cloud.semantic_classes = 2;
+  settings.cloud.ignore_classes = {1};
+  cvo::OdometryPipeline pipeline(settings);
+  constexpr std::size_t kMasked = 4;
+  for (std::size_t k = 0; k <= kMasked + 1; ++k) {
+    cvo::RgbdFrame frame = tumFrame(sequence, k);
+    frame.semantics = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(k == kMasked ? 1 : 0));
+    const double stamp = sequence.frames()[k].depth_stamp;
+    const cvo::PipelineResult result = pipeline.process(stamp, frame);
+    ASSERT_EQ(result.outcome, cvo::FrameOutcome::kProcessed) << "frame " << k << ": " << result.why;
+    if (k == kMasked) {
+      EXPECT_FALSE(result.update.trusted()) << "frame " << k;
+      EXPECT_NE(result.update.problem.find("ignore_classes"), std::string::npos)
+          << result.update.problem;
+    } else if (k > 0) {
+      EXPECT_TRUE(result.update.trusted()) << "frame " << k << ": " << result.update.problem;
+    }
+    if (k == kMasked + 1) {
+      ASSERT_TRUE(result.prior.has_value());
+      EXPECT_TRUE(result.prior->solved) << result.prior->problem;
+      EXPECT_EQ(result.prior->from_stamp, sequence.frames()[kMasked - 1].depth_stamp)
+          << "tracked from the last trusted frame";
+      EXPECT_GE(result.update.track_agreement, 0.0) << "the tracks judged it";
+    }
+  }
+}
+
 TEST(OdometryPipeline, BadInputIsClassifiedOnce) {
   const cvo::TumSequence sequence(kTum);
   cvo::OdometryPipeline pipeline(tumSettings());
