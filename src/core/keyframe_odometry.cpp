@@ -908,7 +908,13 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // lost, 4 restarts).
     const bool moving_lately = movedLately(frame.stamp);
     update.restart_tracks = !moving_lately || frames_since_anchor_ > p.max_lost_frames;
-    if (update.restart_tracks) frames_since_anchor_ = 0;
+    if (update.restart_tracks) {
+      frames_since_anchor_ = 0;
+      // As a first frame: the stretch's origin is the frame the next ones' tracks start from
+      // (priorFramePose), so they guess and judge at once; the last good frame before the
+      // restart is no fallback for frames of the new stretch.
+      if (reference_) last_good_ = GoodFrame{reference_, update.stamp, pose_, covariance_};
+    }
     return;
   }
   update.state = TrackingState::kLost;
