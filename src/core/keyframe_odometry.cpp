@@ -212,9 +212,21 @@ bool KeyframeOdometry::separateSecondMotion(const std::optional<MotionPrior>& pr
           motionsApartPx(*prior, prior->motion, prior->second.motion) >= params().moving_min_px);
 }
 
+std::string KeyframeOdometry::judgeSceneBehind(const OdometryFrame& frame, bool scene_is_second) {
+  if (!frame.prior) return "";
+  std::string why = sceneBehindItsMotion(*frame.prior, scene_is_second, params().min_prior_inliers);
+  if (why.empty()) return "";
+  // Something may move: without it the next frame of KITTI's van and car (stride 3) was
+  // registered from the identity guess, unjudged, and trusted standing still.
+  moving_seen_stamp_ = frame.stamp;
+  split_ = MotionSplit{};
+  split_->why = std::move(why);
+  return split_->why;
+}
+
 std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   split_.reset();
-  if (!separateSecondMotion(frame.prior)) return "";
+  if (!separateSecondMotion(frame.prior)) return judgeSceneBehind(frame, false);
   moving_seen_stamp_ = frame.stamp;
   // With the moving classes left out by the segmentation, two motions a few pixels apart are
   // the still scene's own spread (near and far tracks of an RGB-D camera, whose depth is older
@@ -227,7 +239,7 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   if (frame.moving_classes_left_out &&
       motionsApartPx(*frame.prior, frame.prior->motion, frame.prior->second.motion) <
           kSpreadApartFactor * params().moving_min_px) {
-    return "";
+    return judgeSceneBehind(frame, false);
   }
   if (thirdMotionSeparate(*frame.prior, params().min_prior_inliers, params().moving_min_px)) {
     // Two objects besides the scene: the two-motion evidence cannot say which is the scene's.
@@ -251,6 +263,8 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
                         params().motion_split_ratio, predicted, prediction_error_px);
   if (split_->scene == SceneMotion::kUndecided) return split_->why;
+  const std::string behind = judgeSceneBehind(frame, split_->scene == SceneMotion::kSecond);
+  if (!behind.empty()) return behind;
   MotionPrior scene = sceneFirst(*frame.prior, *split_);
   std::shared_ptr<const LabeledCloud> rest = withoutRegion(frame.cloud, scene, scene.second.pixels);
   if (frame.cloud && rest->size() < kMinSceneShare * frame.cloud->size()) {

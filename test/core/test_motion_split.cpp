@@ -348,3 +348,62 @@ TEST(MotionSplit, MotionsApartGrowsWithTheirDifference) {
 }
 
 }  // namespace
+
+// The object's patch (1 m, its motion first) with the background around it (4 m) whose tracks
+// follow no motion the prior has (a step too large for them to form one): each is moved
+// `miss_px` off where the camera's motion puts it, in alternating directions.
+Scene objectBeforeBrokenBackground(double miss_px) {
+  Scene scene = occludingObject();
+  scene.prior.second.solved = false;
+  for (std::size_t k = 0; k < scene.truth.size(); ++k) {
+    if (scene.truth[k] != 1) continue;
+    const double sign = k % 2 == 0 ? 1.0 : -1.0;
+    scene.prior.tracked_observations[k] += Eigen::Vector2d(sign, -sign) * (miss_px / kFocal);
+  }
+  return scene;
+}
+
+// Proves: tracks that follow no motion, far behind the one the scene is taken to follow, say
+// the scene may be them (the reason names both depths); tracks the motion explains at any depth,
+// or unexplained ones no farther than its own, or fewer than min_tracks, say nothing; with the
+// scene taken to be the second motion, the first's tracks are not unexplained.
+TEST(MotionSplit, TracksFollowingNoMotionFarBehindTheSceneMotionDoubtIt) {
+  const int min_tracks = kParams.min_prior_inliers;
+  const Scene broken = objectBeforeBrokenBackground(8.0);
+  ASSERT_GE(count(broken.truth, 1), min_tracks);
+  const std::string why = cvo::sceneBehindItsMotion(broken.prior, false, min_tracks);
+  EXPECT_NE(why.find("follow no motion lie behind"), std::string::npos) << why;
+  EXPECT_NE(why.find("4 and 1 m"), std::string::npos) << why;
+
+  // A still scene, near and far: its one motion explains every track.
+  Scene still = emptyScene(cameraMotion(), cameraMotion());
+  still.prior.second.solved = false;
+  addTracks(&still, cameraMotion(), 0, 240, 400, 160, 320, 10.0, 1.0);
+  addTracks(&still, cameraMotion(), 0, 20, 620, 20, 460, 40.0, 4.0);
+  EXPECT_EQ(cvo::sceneBehindItsMotion(still.prior, false, min_tracks), "");
+  // Background tracks off their motion by less than the inlier bound follow it.
+  Scene close = objectBeforeBrokenBackground(0.5 * broken.prior.inlier_px);
+  close.prior.second.solved = true;  // the camera's motion, as occludingObject gives it
+  EXPECT_EQ(cvo::sceneBehindItsMotion(close.prior, true, min_tracks), "");
+  close.prior.second.solved = false;
+  EXPECT_NE(cvo::sceneBehindItsMotion(close.prior, false, min_tracks), "");
+
+  // Fewer unexplained tracks than min_tracks: no evidence.
+  EXPECT_EQ(cvo::sceneBehindItsMotion(broken.prior, false, count(broken.truth, 1) + 1), "");
+
+  // The unexplained tracks nearer than the motion's: a near object that formed no motion.
+  Scene swapped = broken;
+  for (std::size_t k = 0; k < swapped.truth.size(); ++k) {
+    const double scale = swapped.truth[k] == 1 ? 0.2 : 4.0;  // background 0.8 m, object 4 m
+    swapped.prior.tracked_points[k] *= scale;
+  }
+  swapped.prior.motion = Eigen::Isometry3d::Identity();  // explains none of the rescaled ones
+  swapped.prior.second.solved = false;
+  EXPECT_EQ(cvo::sceneBehindItsMotion(swapped.prior, false, min_tracks), "");
+
+  // The scene taken to be the second motion (the background's, explained) and the object's
+  // tracks the first's: no track is left unexplained.
+  const Scene two = occludingObject();
+  EXPECT_EQ(cvo::sceneBehindItsMotion(two.prior, true, min_tracks), "");
+  EXPECT_EQ(cvo::sceneBehindItsMotion(two.prior, false, min_tracks), "");
+}

@@ -198,6 +198,9 @@ class KeyframeOdometry {
   // motion made the prior's first and the object's region left out of the frame's cloud. Why the
   // frame cannot be trusted (which motion the scene follows is unknown), or empty.
   std::string judgeSecondMotion(OdometryFrame& frame);
+  // Why the scene may not follow the motion it is taken to (sceneBehindItsMotion), kept as an
+  // undecided split; empty when nothing says so.
+  std::string judgeSceneBehind(const OdometryFrame& frame, bool scene_is_second);
   // Enough inliers to contradict a registration, even at a ratio too low to be a guess.
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.

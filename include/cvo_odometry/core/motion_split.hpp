@@ -56,6 +56,14 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
 // cases, strides 1-3).
 bool thirdMotionSeparate(const MotionPrior& prior, int min_tracks, double moving_min_px);
 
+// Why the scene may not follow the motion it is taken to (the prior's first, or its second
+// where `scene_is_second`): at least `min_tracks` tracks, and a fifth as many as that motion's
+// own, that none of the prior's motions explains lie, by median depth, at least 1.5 times as
+// far as the motion's own tracks. An object near the camera then holds the motion, and the
+// scene behind it, its tracks too broken up by the step to form one, none. Empty when the
+// evidence does not say so.
+std::string sceneBehindItsMotion(const MotionPrior& prior, bool scene_is_second, int min_tracks);
+
 // The prior as the scene sees it: the scene's motion first, its own tracks alone as the inliers
 // (those the other motion explains better left out), the other motion second with its own.
 MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split);
