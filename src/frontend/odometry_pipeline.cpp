@@ -224,7 +224,7 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
   // A frame with nothing usable (everything masked, say a person right in front of the lens)
   // leaves the anchor as it is: the next frame is tracked from the last trusted one, whose pose
   // is known. Anchored on the empty frame, the tracks would relate the next ones to a pose
-  // nobody knows, and a KITTI car lost 5 frames and restarted after a cyclist filled the view.
+  // nobody knows: they could neither guess nor judge until a frame was trusted without them.
   const bool tracks_this_frame =
       settings_.features.enabled && !images.grey.empty() && input.cloud != nullptr;
   if (!settings_.features.enabled || (images.grey.empty() && input.cloud != nullptr)) {
