@@ -21,12 +21,13 @@ namespace {
 
 const std::string kCloud = std::string(CVO_TEST_DATA_DIR) + "/tum_clouds/frame10_8000.cloud";
 
-// Every point within `radius` of queries at (and just off) the cloud's points, exactly once.
+// Every point within `radius` of queries at (and just off) the cloud's points, exactly once; and
+// anyWithin() says whether there is one, there and further off the cloud.
 void expectExactNeighbours(const std::vector<float>& positions, std::size_t n, float cell,
                            float radius) {
   cvo::VoxelGrid grid;
   grid.build(positions.data(), n, cell);
-  std::size_t pairs = 0;
+  std::size_t pairs = 0, lone = 0;
   for (std::size_t q = 0; q < n; q += 37) {
     const float p[3] = {positions[3 * q] + 0.3f * radius, positions[3 * q + 1],
                         positions[3 * q + 2] - 0.2f * radius};
@@ -41,8 +42,20 @@ void expectExactNeighbours(const std::vector<float>& positions, std::size_t n, f
       }
     }
     ASSERT_EQ(found, expected) << "cell " << cell << ", radius " << radius << ", query " << q;
+    EXPECT_TRUE(grid.anyWithin(p, radius)) << "cell " << cell << ", query " << q;
     pairs += found.size();
+    // anyWithin() off the cloud too, where a neighbour may or may not lie within the radius.
+    const float off[3] = {p[0] + 1.2f * radius, p[1] - 0.9f * radius, p[2]};
+    bool any = false;
+    for (std::size_t i = 0; i < n && !any; ++i) {
+      const float dx = positions[3 * i] - off[0], dy = positions[3 * i + 1] - off[1],
+                  dz = positions[3 * i + 2] - off[2];
+      any = dx * dx + dy * dy + dz * dz <= radius * radius;
+    }
+    ASSERT_EQ(grid.anyWithin(off, radius), any) << "cell " << cell << ", query " << q << " off";
+    lone += any ? 0 : 1;
   }
+  EXPECT_GT(lone, 0u) << "some queries off the cloud had no neighbour at radius " << radius;
   EXPECT_GT(pairs, n / 37) << "the queries found neighbours at radius " << radius;
 }
 
@@ -50,8 +63,9 @@ TEST(DenseGrid, FindsExactlyTheNeighboursWithinTheRadius) {
   const cvo::LabeledCloud cloud = cvo::readCloud(kCloud);
   ASSERT_GT(cloud.size(), 7000u);
   for (const float radius : {0.03f, 0.1f, 0.4f}) {
-    // The cell as large as the radius, and smaller: the ball then spans several cells.
-    for (const float cells_per_radius : {1.0f, 2.0f, 3.0f}) {
+    // The cell as large as the radius, smaller (the ball then spans several cells), and three
+    // times larger (KeyframeOdometry's consistency grid).
+    for (const float cells_per_radius : {1.0f, 2.0f, 3.0f, 1.0f / 3.0f}) {
       expectExactNeighbours(cloud.positionData(), cloud.size(), radius / cells_per_radius, radius);
     }
   }

@@ -62,6 +62,19 @@ class VoxelGrid {
     });
   }
 
+  // Whether a point lies within `radius` of p (the ranges' points are skipped once one does).
+  bool anyWithin(const float* p, float radius) const {
+    const float r2 = radius * radius;
+    bool found = false;
+    forEachRange(p, radius, [&](std::uint32_t begin, std::uint32_t end) {
+      for (std::uint32_t k = begin; k < end && !found; ++k) {
+        const float ex = xs_[k] - p[0], ey = ys_[k] - p[1], ez = zs_[k] - p[2];
+        found = ex * ex + ey * ey + ez * ez <= r2;
+      }
+    });
+    return found;
+  }
+
   // The points in sorted order (the slots forEachRange's ranges index).
   const float* sortedX() const { return xs_.data(); }
   const float* sortedY() const { return ys_.data(); }
