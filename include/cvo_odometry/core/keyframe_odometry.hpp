@@ -26,6 +26,7 @@
 #include "cvo_odometry/core/motion_prior.hpp"
 #include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/photometric_rotation.hpp"
+#include "cvo_odometry/core/voxel_grid.hpp"
 
 namespace cvo {
 
@@ -205,6 +206,13 @@ class KeyframeOdometry {
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
   double referenceSelfProduct(double ell);
+  // A grid over the reference's points for consistency queries, built once per reference.
+  const VoxelGrid& referenceGrid();
+  // Why `reference_from_cloud` cannot be the scene's motion: it brings too few of the cloud's
+  // points near the reference's, hardly more than the reference's own pose does. Empty when
+  // it explains enough of the view.
+  std::string viewUnexplained(const LabeledCloud& cloud,
+                              const Eigen::Isometry3d& reference_from_cloud);
   void checkStamp(double stamp) const;
   // A frame without a reference: it becomes the reference (with enough points); the pose holds.
   OdometryUpdate startFrom(const OdometryFrame& frame);
@@ -235,6 +243,9 @@ class KeyframeOdometry {
   CvoRegistration registration_;
   BlockPool photometric_pool_;  // num_threads threads for the photometric stage
   std::shared_ptr<const LabeledCloud> reference_;
+  // referenceGrid()'s grid and the cloud it was built over.
+  VoxelGrid reference_grid_;
+  std::weak_ptr<const LabeledCloud> reference_grid_cloud_;
   // The reference is a lost frame: its pose a guess (constant velocity, a prior, or held at a
   // restart), not a registration's.
   bool reference_guessed_ = false;
