@@ -42,7 +42,7 @@ constexpr double kMinSceneShare = 0.3;
 // 1-6 and depth limits 15-80 m), that frame was the only one below both: right ones went down
 // to 10 % on TUM (under 5 % at the reference's pose) and 20 % on KITTI, and to 1.16 times the
 // reference's pose's share where the camera barely moved (55 % of the points). A sample of
-// kViewSample points decides as every point did there.
+// kViewSample points or more decides as every point did there.
 constexpr double kMinViewShare = 0.25;
 constexpr double kViewOverStill = 1.5;
 constexpr std::size_t kViewSample = 1000;
@@ -378,8 +378,8 @@ LabeledCloud consistentPoints(const LabeledCloud& cloud, const VoxelGrid& other,
       nullptr);
 }
 
-// The share of `cloud`'s points, at most about kViewSample of them spread over it, that T moves
-// near a point of `other`'s.
+// The share of `cloud`'s points that T moves near a point of `other`'s, over every
+// (size / kViewSample)-th point: kViewSample to twice as many.
 double consistentShare(const LabeledCloud& cloud, const VoxelGrid& other,
                        const Eigen::Isometry3f& T) {
   const std::size_t step = std::max<std::size_t>(1, cloud.size() / kViewSample);
@@ -447,7 +447,9 @@ std::optional<KeyframeOdometry::Attempt> KeyframeOdometry::attemptWithConsistent
   reference_ = kept_reference;
   reference_self_.reset();
   source_self_.reset();
-  Attempt a = attempt(kept_cloud, Guess{GuessKind::kFeatures, motion}, frame, dt);
+  // The kept points explain the view by construction (at least kMinSceneShare of the frame's
+  // follow the motion it starts from): no view judgement, and no grid over the kept reference.
+  Attempt a = attempt(kept_cloud, Guess{GuessKind::kFeatures, motion}, frame, dt, false);
   a.left_out_share = 1.0 - static_cast<double>(kept_cloud.size()) / cloud.size();
   return a;
 }
@@ -498,7 +500,8 @@ void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval
 }
 
 KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, const Guess& guess,
-                                                    const OdometryFrame& frame, double dt) {
+                                                    const OdometryFrame& frame, double dt,
+                                                    bool judge_view) {
   const CvoParams& p = params();
   Attempt a;
   a.guess = guess.kind;
@@ -631,7 +634,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       }
     }
   }
-  if (a.good) {
+  if (a.good && judge_view) {
     // Tracks and registration can agree on an object's motion (a car crossing, its corners
     // tracked, the scene's broken up by a long step): the scene must follow it too.
     std::string why = viewUnexplained(cloud, a.result.transform);

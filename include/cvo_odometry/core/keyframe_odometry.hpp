@@ -167,8 +167,10 @@ class KeyframeOdometry {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     Matrix6d covariance = Matrix6d::Zero();
   };
+  // A registration of `cloud` to reference_ from `guess`, judged; `judge_view`: also refused
+  // when it explains too little of the view (viewUnexplained).
   Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
-                  double dt);
+                  double dt, bool judge_view = true);
   // The guesses to try, in order, and those kept for a retry.
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
                      std::vector<Guess>* retries) const;
@@ -206,7 +208,8 @@ class KeyframeOdometry {
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
   double referenceSelfProduct(double ell);
-  // A grid over the reference's points for consistency queries, built once per reference.
+  // A grid over the reference's points for consistency queries, built again only when
+  // reference_ is another cloud.
   const VoxelGrid& referenceGrid();
   // Why `reference_from_cloud` cannot be the scene's motion: it brings too few of the cloud's
   // points near the reference's, hardly more than the reference's own pose does. Empty when
