@@ -275,6 +275,14 @@ std::string readAll(const fs::path& path) {
   return text.str();
 }
 
+// cvo_make_dynamic on `source` (kTum or kKitti) into `out`, with `options`.
+cvo_test::CommandOutput makeDynamic(const fs::path& source, const fs::path& out,
+                                    const std::string& options) {
+  const std::string kind = source == kKitti ? "--kitti" : "--tum";
+  return cvo_test::runCommand(std::string("'") + CVO_MAKE_DYNAMIC + "' " + kind + " '" +
+                              source.string() + "' --out '" + out.string() + "' " + options);
+}
+
 // Proves: cvo_make_dynamic --tum writes rgb/, depth/, labels/rgb/, the three listings,
 // groundtruth.txt and object.txt for every frame; colour, labels and depth are the board
 // rendered at each image's own stamp (the depth in TUM's units, the scene's depth elsewhere
@@ -282,9 +290,8 @@ std::string readAll(const fs::path& path) {
 // one removed, it stops).
 TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
   const fs::path out = freshFolder("tum");
-  const cvo_test::CommandOutput made = cvo_test::runCommand(
-      std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
-      out.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5");
+  const cvo_test::CommandOutput made =
+      makeDynamic(kTum, out, "--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5");
   ASSERT_EQ(made.status, 0) << made.output;
   const cvo::TumSequence source(kTum.string());
   const std::size_t frames = source.frames().size();
@@ -376,9 +383,7 @@ TEST(MakeDynamic, LabelledRunsTrackEveryFrame) {
   for (const auto& [name, options] : cases) {
     SCOPED_TRACE(name);
     const fs::path out = freshFolder("labelled_" + name);
-    const cvo_test::CommandOutput made =
-        cvo_test::runCommand(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() +
-                             "' --out '" + out.string() + "' " + options);
+    const cvo_test::CommandOutput made = makeDynamic(kTum, out, options);
     ASSERT_EQ(made.status, 0) << made.output;
     const cvo_test::CommandOutput ran = cvo_test::runCommand(
         std::string("'") + CVO_RUN_SEQUENCE + "' --quiet --backend cpu --tum '" + out.string() +
@@ -404,12 +409,10 @@ TEST(MakeDynamic, ObjectTableMeasuresTheObjectNotItsLabels) {
   for (const int error : {0, 6}) {
     SCOPED_TRACE("--label-error " + std::to_string(error));
     const fs::path out = freshFolder("table" + std::to_string(error));
-    const cvo_test::CommandOutput made =
-        cvo_test::runCommand(std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() +
-                             "' --out '" + out.string() +
-                             "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5"
-                             " --label-error " +
-                             std::to_string(error));
+    const cvo_test::CommandOutput made = makeDynamic(
+        kTum, out,
+        "--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --start 0.2,0.5 --label-error " +
+            std::to_string(error));
     ASSERT_EQ(made.status, 0) << made.output;
     const std::vector<std::string> rows = dataLines(out / "object.txt");
     ASSERT_EQ(rows.size(), source.frames().size());
@@ -453,9 +456,8 @@ double matchedDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Mat
 // the disparity of its depth within 0.5 px; and the runner reads the folder with its labels.
 TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
   const fs::path out = freshFolder("kitti");
-  const cvo_test::CommandOutput made = cvo_test::runCommand(
-      std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
-      out.string() + "' --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6");
+  const cvo_test::CommandOutput made = makeDynamic(
+      kKitti, out, "--area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6");
   ASSERT_EQ(made.status, 0) << made.output;
   for (const char* file : {"calib.txt", "times.txt", "poses.txt"})
     EXPECT_EQ(readAll(out / file), readAll(kKitti / file)) << file;
@@ -490,11 +492,12 @@ TEST(MakeDynamic, KittiPairIsConsistentWithTheBoardsDepth) {
   fs::remove_all(out);
 }
 
-// The trusted poses of `folder` (KITTI layout) at stride 3 from frame 1, each against the one
-// before it: how far off the ground truth's step (m), and the step (m).
+// The trusted poses of `folder` (KITTI layout) at stride 3 from frame 1, written to
+// `estimate_path`, each against the one before it: how far off the ground truth's step (m), and
+// the step (m).
 std::vector<std::pair<double, double>> strideThreeErrors(const fs::path& folder,
+                                                         const fs::path& estimate_path,
                                                          std::string* output) {
-  const fs::path estimate_path = folder / "estimate.txt";
   const cvo_test::CommandOutput ran = cvo_test::runCommand(
       std::string("'") + CVO_RUN_SEQUENCE + "' --quiet --backend cpu --kitti '" + folder.string() +
       "' --stride 3 --first 1 --lost-frame-policy publish_nothing --format tum --out '" +
@@ -530,21 +533,19 @@ std::vector<std::pair<double, double>> strideThreeErrors(const fs::path& folder,
 TEST(MakeDynamic, CarCrossingOnALongStepIsNotTakenForTheScene) {
   const fs::path still = freshFolder("kitti_still");
   fs::create_directories(still);
-  for (const char* entry : {"calib.txt", "times.txt", "poses.txt", "image_0", "image_1"})
-    fs::copy(kKitti / entry, still / entry, fs::copy_options::recursive);
   std::string output;
-  const std::vector<std::pair<double, double>> still_errors = strideThreeErrors(still, &output);
+  const std::vector<std::pair<double, double>> still_errors =
+      strideThreeErrors(kKitti, still / "estimate.txt", &output);
   ASSERT_EQ(still_errors.size(), 2u) << "frames 4 and 7 trusted without the car: " << output;
   for (const auto& [error, step] : still_errors)
     EXPECT_LT(error, 0.05 * step) << output;
   fs::remove_all(still);
 
   const fs::path out = freshFolder("kitti_car_crossing");
-  const cvo_test::CommandOutput made = cvo_test::runCommand(
-      std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
-      out.string() + "' --area 0.12 --depth 15 --velocity -6,0,0 --start 0.7,0.6");
+  const cvo_test::CommandOutput made =
+      makeDynamic(kKitti, out, "--area 0.12 --depth 15 --velocity -6,0,0 --start 0.7,0.6");
   ASSERT_EQ(made.status, 0) << made.output;
-  for (const auto& [error, step] : strideThreeErrors(out, &output)) {
+  for (const auto& [error, step] : strideThreeErrors(out, out / "estimate.txt", &output)) {
     EXPECT_LT(error, 0.5 * step) << "a trusted pose " << error << " m off a " << step
                                  << " m step: " << output;
   }
@@ -555,9 +556,8 @@ TEST(MakeDynamic, CarCrossingOnALongStepIsNotTakenForTheScene) {
 // labelled run's baseline: the same view hidden, nothing moving).
 TEST(MakeDynamic, LabelsOnlyKeepsTheRecordedImages) {
   const fs::path tum = freshFolder("tum_labels_only");
-  const cvo_test::CommandOutput made_tum = cvo_test::runCommand(
-      std::string("'") + CVO_MAKE_DYNAMIC + "' --tum '" + kTum.string() + "' --out '" +
-      tum.string() + "' --area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --labels-only");
+  const cvo_test::CommandOutput made_tum =
+      makeDynamic(kTum, tum, "--area 0.33 --depth 0.65 --velocity 0.25,0,0.2 --labels-only");
   ASSERT_EQ(made_tum.status, 0) << made_tum.output;
   const cvo::TumSequence source(kTum.string()), made(tum.string());
   ASSERT_EQ(made.frames().size(), source.frames().size());
@@ -576,9 +576,8 @@ TEST(MakeDynamic, LabelsOnlyKeepsTheRecordedImages) {
   fs::remove_all(tum);
 
   const fs::path kitti = freshFolder("kitti_labels_only");
-  const cvo_test::CommandOutput made_kitti = cvo_test::runCommand(
-      std::string("'") + CVO_MAKE_DYNAMIC + "' --kitti '" + kKitti.string() + "' --out '" +
-      kitti.string() + "' --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --labels-only");
+  const cvo_test::CommandOutput made_kitti = makeDynamic(
+      kKitti, kitti, "--area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --labels-only");
   ASSERT_EQ(made_kitti.status, 0) << made_kitti.output;
   const cvo::KittiSequence kitti_source(kKitti.string());
   const cvo::KittiSequence kitti_made(kitti.string(), 0, (kitti / "labels" / "image_0").string());
