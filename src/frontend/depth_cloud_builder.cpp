@@ -1,11 +1,14 @@
 #include "cvo_odometry/frontend/depth_cloud_builder.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -23,6 +26,22 @@ namespace {
 std::string sizeText(const cv::Mat& m) {
   return std::to_string(m.cols) + "x" + std::to_string(m.rows);
 }
+
+// `mask` moved by `shift` px (rounded), zero where nothing moved in.
+cv::Mat translated(const cv::Mat& mask, const cv::Point2d& shift) {
+  const int dx = static_cast<int>(std::lround(shift.x)),
+            dy = static_cast<int>(std::lround(shift.y));
+  cv::Mat out = cv::Mat::zeros(mask.size(), mask.type());
+  const int width = mask.cols - std::abs(dx), height = mask.rows - std::abs(dy);
+  if (width > 0 && height > 0) {
+    mask(cv::Rect(std::max(0, -dx), std::max(0, -dy), width, height))
+        .copyTo(out(cv::Rect(std::max(0, dx), std::max(0, dy), width, height)));
+  }
+  return out;
+}
+
+// Labels further apart in time than this (s) tell no speed: a gap in the stream.
+constexpr double kMaxLabelInterval = 1.0;
 
 }  // namespace
 
@@ -113,6 +132,117 @@ std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
   return normalisedRays(std::vector<cv::Point2f>(pixels.begin(), pixels.end()), K);
 }
 
+LabelRegionMotions labelRegionMotions(const cv::Mat& previous, const cv::Mat& current) {
+  if (previous.size() != current.size() || previous.type() != CV_8UC1 ||
+      current.type() != CV_8UC1) {
+    throw std::invalid_argument("labelRegionMotions: two 8-bit masks of one size");
+  }
+  LabelRegionMotions out;
+  cv::Mat before_regions, before_stats, before_centres, now_stats, now_centres;
+  const int before_count =
+      cv::connectedComponentsWithStats(previous, before_regions, before_stats, before_centres, 8);
+  const int now_count =
+      cv::connectedComponentsWithStats(current, out.regions, now_stats, now_centres, 8);
+  out.motion.assign(static_cast<std::size_t>(now_count), std::nullopt);
+  // Pixels each region (of current) shares with each region of previous.
+  std::vector<int> shared(static_cast<std::size_t>(now_count) * before_count, 0);
+  for (int v = 0; v < current.rows; ++v) {
+    const int* now_row = out.regions.ptr<int>(v);
+    const int* before_row = before_regions.ptr<int>(v);
+    for (int u = 0; u < current.cols; ++u) {
+      if (now_row[u] > 0 && before_row[u] > 0) {
+        ++shared[static_cast<std::size_t>(now_row[u]) * before_count + before_row[u]];
+      }
+    }
+  }
+  // Regions of previous that share no pixel with current: gone from view, or flickering off.
+  std::vector<bool> continued(static_cast<std::size_t>(before_count), false);
+  for (int r = 1; r < now_count; ++r) {
+    for (int p = 1; p < before_count; ++p)
+      continued[p] = continued[p] || shared[static_cast<std::size_t>(r) * before_count + p] > 0;
+  }
+  out.vanished = cv::Mat::zeros(previous.size(), CV_8UC1);
+  for (int v = 0; v < previous.rows; ++v) {
+    const int* before_row = before_regions.ptr<int>(v);
+    std::uint8_t* gone = out.vanished.ptr<std::uint8_t>(v);
+    for (int u = 0; u < previous.cols; ++u)
+      gone[u] = before_row[u] > 0 && !continued[before_row[u]] ? 255 : 0;
+  }
+  const auto stat = [](const cv::Mat& stats, int region, int which) {
+    return stats.at<int>(region, which);
+  };
+  for (int r = 1; r < now_count; ++r) {
+    const int* row = &shared[static_cast<std::size_t>(r) * before_count];
+    const int p = static_cast<int>(std::max_element(row + 1, row + before_count) - row);
+    if (before_count < 2 || row[p] == 0) continue;  // new in view, or flickering on
+    // Regions merging or splitting have no one motion.
+    const double area_ratio = static_cast<double>(stat(now_stats, r, cv::CC_STAT_AREA)) /
+                              stat(before_stats, p, cv::CC_STAT_AREA);
+    if (area_ratio < 0.5 || area_ratio > 2.0) continue;
+    cv::Point2d moved;
+    for (int axis = 0; axis < 2; ++axis) {
+      const int first = axis == 0 ? cv::CC_STAT_LEFT : cv::CC_STAT_TOP;
+      const int extent = axis == 0 ? cv::CC_STAT_WIDTH : cv::CC_STAT_HEIGHT;
+      const int size = axis == 0 ? current.cols : current.rows;
+      const int lo_now = stat(now_stats, r, first), lo_before = stat(before_stats, p, first);
+      const int hi_now = lo_now + stat(now_stats, r, extent);
+      const int hi_before = lo_before + stat(before_stats, p, extent);
+      const bool cut_low = lo_now == 0 || lo_before == 0;
+      const bool cut_high = hi_now == size || hi_before == size;
+      // Where the image border cuts the region, its centre moves slower than it does: the
+      // edge the border does not cut moves as it does.
+      double shift = now_centres.at<double>(r, axis) - before_centres.at<double>(p, axis);
+      if (cut_low && !cut_high) shift = hi_now - hi_before;
+      if (cut_high && !cut_low) shift = lo_now - lo_before;
+      (axis == 0 ? moved.x : moved.y) = shift;
+    }
+    out.motion[static_cast<std::size_t>(r)] = moved;
+  }
+  return out;
+}
+
+std::vector<DepthCloudBuilder::LabelShift> DepthCloudBuilder::labelShifts(
+    const cv::Mat& labels, cv::Size size, const LabelTiming& timing) {
+  // A quarter of the resolution (any labelled pixel marks its cell): a few tenths of a ms.
+  constexpr int kScale = 4;
+  const cv::Size cells((size.width + kScale - 1) / kScale, (size.height + kScale - 1) / kScale);
+  cv::Mat small = cv::Mat::zeros(cells, CV_8UC1);  // empty labels: every label gone
+  if (!labels.empty()) {
+    cv::resize(labels, small, cells, 0, 0, cv::INTER_AREA);
+    small = small > 0;
+  }
+  std::vector<LabelShift> shifts;
+  const double interval = timing.stamp - last_labels_stamp_;
+  if (!last_labels_.empty() && last_labels_.size() == small.size() &&
+      timing.depth_after_labels != 0.0 && interval > 0.0 && interval <= kMaxLabelInterval) {
+    const LabelRegionMotions motions = labelRegionMotions(last_labels_, small);
+    // The depth's instant: ahead of the labels (depth after colour), or behind.
+    const double to_depth = timing.depth_after_labels / interval * kScale;
+    const double most = std::max(size.width, size.height) / 8.0;  // px
+    for (std::size_t r = 1; r < motions.motion.size(); ++r) {
+      if (!motions.motion[r]) continue;
+      cv::Point2d shift = *motions.motion[r] * to_depth;
+      const double length = cv::norm(shift);
+      if (length > most) shift *= most / length;
+      // The border takes in motion up to its own width.
+      if (std::max(std::abs(shift.x), std::abs(shift.y)) <= options_.ignore_border_px) continue;
+      cv::Mat pixels;  // the region's cells at the labels' resolution, then its labelled pixels
+      cv::resize(motions.regions == static_cast<int>(r), pixels, size, 0, 0, cv::INTER_NEAREST);
+      shifts.push_back({pixels & labels, shift});
+    }
+    // Depth older than the colour: what left the labels since the last frame (out of view, or
+    // missed by the segmentation) may still be in the depth, near where it was labelled then.
+    if (timing.depth_after_labels < 0.0 && cv::countNonZero(motions.vanished) > 0) {
+      cv::Mat gone;
+      cv::resize(motions.vanished, gone, size, 0, 0, cv::INTER_NEAREST);
+      shifts.push_back({gone, cv::Point2d(0.0, 0.0)});
+    }
+  }
+  last_labels_ = cv::countNonZero(small) > 0 ? small : cv::Mat();
+  last_labels_stamp_ = timing.stamp;
+  return shifts;
+}
+
 DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
     : options_(options), selector_(options.selector) {
   options_.validate();
@@ -124,7 +254,7 @@ DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
 LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth,
                                       const PinholeIntrinsics& intrinsics,
                                       const cv::Mat& semantics_image, FrontendStats* stats,
-                                      FrameImages* images) {
+                                      FrameImages* images, const LabelTiming* timing) {
   const auto start = std::chrono::steady_clock::now();
   if (image.empty()) throw std::invalid_argument("colour image is empty");
   if (depth.empty()) throw std::invalid_argument("depth image is empty");
@@ -149,13 +279,26 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     semantics = std::make_unique<SemanticImage>(semantics_image, options_.semantic_classes,
                                                 options_.ignore_classes);
   }
-  // Pixels of ignored classes, grown by the border: no stage uses them.
+  // Pixels of ignored classes, grown by the border (and their motion): no stage uses them.
   cv::Mat excluded;
+  int motion_px = 0;
   if (semantics) {
     excluded = semantics->excludedMask();
-    if (cv::countNonZero(excluded) == 0) {
-      excluded.release();
-    } else if (options_.ignore_border_px > 0) {
+    if (cv::countNonZero(excluded) == 0) excluded.release();
+    if (timing) {
+      // Each region that moved further than the border reaches, also where the depth shows it.
+      cv::Mat at_depth_instant;
+      for (const LabelShift& region : labelShifts(excluded, image.size(), *timing)) {
+        const double shift = std::max(std::abs(region.shift.x), std::abs(region.shift.y));
+        const cv::Mat moved = shift > 0.0 ? translated(region.pixels, region.shift) : region.pixels;
+        at_depth_instant = at_depth_instant.empty() ? moved : (at_depth_instant | moved);
+        motion_px = std::max(motion_px, static_cast<int>(std::lround(shift)));
+      }
+      if (!at_depth_instant.empty()) {
+        excluded = excluded.empty() ? at_depth_instant : (excluded | at_depth_instant);
+      }
+    }
+    if (!excluded.empty() && options_.ignore_border_px > 0) {
       // A square: separable, and at least the border in every direction.
       const int side = 2 * options_.ignore_border_px + 1;
       cv::dilate(excluded, excluded,
@@ -220,6 +363,7 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
   cloud.setImage(intensityImage(grey, intrinsics, options_.image_levels, level_buffers_, excluded));
   if (images) *images = FrameImages{grey, depth, excluded};
   local.valid_depth_pixels = valid_count;
+  local.label_motion_px = motion_px;
   local.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (stats) {

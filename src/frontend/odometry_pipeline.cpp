@@ -151,11 +151,12 @@ void OdometryPipeline::moveKeptDepths(double from, double to,
       depthAtNewOffset(from, to, *focal_baseline, near, std::numeric_limits<double>::infinity()));
 }
 
-std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(const CameraFrame& frame,
+std::shared_ptr<const LabeledCloud> OdometryPipeline::buildCloud(double stamp,
+                                                                 const CameraFrame& frame,
                                                                  FrontendStats* stats,
                                                                  FrameImages* images) {
   if (const auto* rgbd = std::get_if<RgbdFrame>(&frame)) {
-    return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats, images));
+    return std::make_shared<const LabeledCloud>(rgbd_builder_->build(*rgbd, stats, images, stamp));
   }
   const auto& stereo = std::get<StereoFrame>(frame);
   // A new camera starts the offset again: the old rig's kept depths go to the start as well.
@@ -211,7 +212,7 @@ PipelineResult OdometryPipeline::process(double stamp, const CameraFrame& frame,
                                             ? std::get<RgbdFrame>(frame).intrinsics
                                             : std::get<StereoFrame>(frame).intrinsics;
   try {
-    input.cloud = buildCloud(frame, &result.stats, &images);
+    input.cloud = buildCloud(stamp, frame, &result.stats, &images);
   } catch (const EmptyFrameError& e) {
     input.why_no_cloud = e.what();  // well-formed, nothing to track: a lost frame
   } catch (const std::invalid_argument& e) {

@@ -1,8 +1,8 @@
 #include "cvo_odometry/ros/ros_conversions.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -128,6 +128,9 @@ CameraFrame rgbdFrameFromMsgs(const sensor_msgs::Image& image, const sensor_msgs
   frame.depth = depthImageFromMsg(depth);
   frame.intrinsics = intrinsicsFromCameraInfo(info);
   if (labels) frame.semantics = labelImageFromMsg(*labels);
+  // The labels are the colour image's: a moving object's depth lies off them by this much of
+  // its motion.
+  frame.depth_after_colour = (depth.header.stamp - image.header.stamp).toSec();
   return frame;
 }
 

@@ -176,6 +176,10 @@ int main(int argc, char** argv) {
         if (result.stats.spaced_out > 0) {
           std::cerr << " (" << result.stats.spaced_out << " left out for point_spacing)";
         }
+        if (result.stats.label_motion_px > 0) {
+          std::cerr << " (ignored classes moved " << result.stats.label_motion_px
+                    << " px to the depth's instant)";
+        }
         if (update.attempts > 0) {
           std::cerr << ", " << update.report.iterations << " iterations, " << std::setprecision(2)
                     << std::fixed << update.report.time_ms << " ms (frame " << result.total_ms

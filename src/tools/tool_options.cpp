@@ -149,6 +149,8 @@ SequenceInput openSequence(const CommandLine& cli) {
       frame.intrinsics = intrinsics;
       sequence->load(k, &frame.image, &frame.depth);
       frame.semantics = labelsOf(sequence->frames()[k].rgb_listed);
+      frame.depth_after_colour =
+          sequence->frames()[k].depth_stamp - sequence->frames()[k].rgb_stamp;
       return CameraFrame(frame);
     };
     return input;

@@ -148,8 +148,12 @@ TEST(RosConversions, FramesFromMessagesRefuseWhatTheyCannotRead) {
   sensor_msgs::CameraInfo info;
   info.width = 4, info.height = 3;
   info.K = {2, 0, 2, 0, 2, 1.5, 0, 0, 1};
+  image.header.stamp = ros::Time(20.0);
+  depth.header.stamp = ros::Time(19.985);
   const cvo::CameraFrame frame = cvo::rgbdFrameFromMsgs(image, info, depth, nullptr);
   EXPECT_EQ(std::get<cvo::RgbdFrame>(frame).image.cols, 4);
+  // Depth 15 ms before colour: where a moving labelled object's depth lies (LabelTiming).
+  EXPECT_NEAR(std::get<cvo::RgbdFrame>(frame).depth_after_colour, -0.015, 1e-6);
   image.encoding = "bgr16";
   EXPECT_THROW(cvo::rgbdFrameFromMsgs(image, info, depth, nullptr), std::invalid_argument);
   image.encoding = "bgr8";

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -45,6 +46,9 @@ struct CloudBuilderOptions {
 
 struct FrontendStats {
   SelectionStats selection;
+  // How far (px) ignored regions were moved to the depth image's instant, beyond what
+  // ignore_border_px takes in (LabelTiming); 0: none was.
+  int label_motion_px = 0;
   std::size_t spaced_out = 0;  // selected points left out for min_point_spacing
   std::size_t valid_depth_pixels = 0;
   double matching_ms = 0.0;  // stereo matching, part of time_ms
@@ -78,6 +82,27 @@ std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point2f>& pixels,
 std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
                                         const PinholeIntrinsics& intrinsics);
 
+// When the frame was taken, for labelled objects that move: labels describe the colour image,
+// and a depth image taken at another instant (RGB-D cameras whose streams are not synchronised:
+// TUM's Kinect, up to half a frame apart) shows a moving object where it was or will be then,
+// off its labels by its image speed times the gap.
+struct LabelTiming {
+  double stamp = 0.0;               // the frame's time (s); frame to frame gives the speed
+  double depth_after_labels = 0.0;  // the depth image's stamp minus the labels' (s)
+};
+
+// How labelled regions moved from `previous` to `current` (CV_8UC1 masks of one size, non-zero
+// where labelled): each connected region of `current` that shares pixels with one of
+// `previous` of a like area (half to twice) moved as its centre did, or, where the image border
+// cuts it, as its uncut edge did. A region new in view (or a segmentation flickering on), or
+// one merging or splitting, has no motion.
+struct LabelRegionMotions {
+  cv::Mat regions;                                 // CV_32S: current's regions, 1.., 0 unlabelled
+  std::vector<std::optional<cv::Point2d>> motion;  // by region (px)
+  cv::Mat vanished;  // CV_8UC1: previous's regions that share no pixel with current's
+};
+LabelRegionMotions labelRegionMotions(const cv::Mat& previous, const cv::Mat& current);
+
 class DepthCloudBuilder {
  public:
   explicit DepthCloudBuilder(const CloudBuilderOptions& options);
@@ -88,9 +113,13 @@ class DepthCloudBuilder {
   // make no sense or do not match the image, a missing or unusable segmentation image; throws
   // EmptyFrameError (a std::invalid_argument) when no pixel has depth in range or every selected
   // one is in an ignored class.
+  // With `timing`, ignored regions that move are also left out where they are at the depth
+  // image's instant (labelRegionMotions against the previous call's labels; nothing on the
+  // first call or after a gap of over a second).
   LabeledCloud build(const cv::Mat& image, const cv::Mat& depth_metres,
                      const PinholeIntrinsics& intrinsics, const cv::Mat& semantics,
-                     FrontendStats* stats, FrameImages* images = nullptr);
+                     FrontendStats* stats, FrameImages* images = nullptr,
+                     const LabelTiming* timing = nullptr);
 
   const CloudBuilderOptions& options() const { return options_; }
 
@@ -101,6 +130,18 @@ class DepthCloudBuilder {
   // The photometric levels' buffers, reused from frame to frame (shared with the images, which
   // hand theirs back when destroyed, on whichever thread).
   std::shared_ptr<FloatBufferPool> level_buffers_;
+  // The last timed frame's ignored pixels (at a quarter of the resolution) and its stamp.
+  cv::Mat last_labels_;
+  double last_labels_stamp_ = 0.0;
+  // The labelled regions that moved since the last frame (LabelTiming), each with the shift (px)
+  // that puts it where the depth image shows it, and, where the depth is older than the colour,
+  // the last frame's regions gone from the labels (shift 0). Keeps `labels` for the next frame.
+  struct LabelShift {
+    cv::Mat pixels;  // the region's labelled pixels
+    cv::Point2d shift;
+  };
+  std::vector<LabelShift> labelShifts(const cv::Mat& labels, cv::Size size,
+                                      const LabelTiming& timing);
 };
 
 }  // namespace cvo

@@ -97,8 +97,8 @@ class OdometryPipeline {
   void moveKeptDepths(double from, double to, std::optional<double> focal_baseline);
   // The frame's cloud by the front end, or why it has none (EmptyFrameError); malformed input
   // throws std::invalid_argument.
-  std::shared_ptr<const LabeledCloud> buildCloud(const CameraFrame& frame, FrontendStats* stats,
-                                                 FrameImages* images);
+  std::shared_ptr<const LabeledCloud> buildCloud(double stamp, const CameraFrame& frame,
+                                                 FrontendStats* stats, FrameImages* images);
   // The prior's own pose for this frame.
   void advancePriorPose(PipelineResult& result);
   std::string staleness(const CameraFrame& frame);

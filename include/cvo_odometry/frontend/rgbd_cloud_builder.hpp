@@ -16,7 +16,10 @@ struct RgbdFrame {
   cv::Mat image;  // 8-bit BGR or grey
   cv::Mat depth;  // 16UC1 (scaled) or 32FC1 (metres), registered to `image`
   PinholeIntrinsics intrinsics;
-  cv::Mat semantics;  // optional: class ids or class probabilities
+  cv::Mat semantics;  // optional: class ids or class probabilities, of `image`
+  // The depth image's stamp minus the colour image's (s): where they differ, labelled objects
+  // that move are left out with their motion over the gap (LabelTiming).
+  double depth_after_colour = 0.0;
 };
 
 class RgbdCloudBuilder {
@@ -25,8 +28,9 @@ class RgbdCloudBuilder {
 
   // Throws std::invalid_argument naming the problem: empty images, mismatched sizes, an
   // unsupported encoding, intrinsics that make no sense, or no pixel with valid depth.
+  // `stamp`: the frame's time (s), for the motion of labelled objects (depth_after_colour).
   LabeledCloud build(const RgbdFrame& frame, FrontendStats* stats = nullptr,
-                     FrameImages* images = nullptr);
+                     FrameImages* images = nullptr, double stamp = 0.0);
 
   const RgbdFrontendOptions& options() const { return options_; }
 
