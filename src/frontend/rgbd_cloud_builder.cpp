@@ -18,7 +18,8 @@ LabeledCloud RgbdCloudBuilder::build(const RgbdFrame& frame, FrontendStats* stat
   const cv::Mat depth =
       depthToMetres(frame.depth, options_.depth_units_per_metre, options_.cloud.min_depth,
                     std::numeric_limits<double>::infinity());
-  const LabelTiming timing{stamp, frame.depth_after_colour};
+  // The labels move between colour instants: the pipeline's stamp is the depth image's.
+  const LabelTiming timing{stamp - frame.depth_after_colour, frame.depth_after_colour};
   LabeledCloud cloud = cloud_builder_.build(frame.image, depth, frame.intrinsics, frame.semantics,
                                             stats, images, &timing);
   if (stats) {

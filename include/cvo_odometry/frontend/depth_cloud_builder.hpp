@@ -46,8 +46,8 @@ struct CloudBuilderOptions {
 
 struct FrontendStats {
   SelectionStats selection;
-  // How far (px) ignored regions were moved to the depth image's instant, beyond what
-  // ignore_border_px takes in (LabelTiming); 0: none was.
+  // The largest shift (px) of an ignored region moved to the depth image's instant (LabelTiming;
+  // only shifts beyond ignore_border_px are made); 0: none.
   int label_motion_px = 0;
   std::size_t spaced_out = 0;  // selected points left out for min_point_spacing
   std::size_t valid_depth_pixels = 0;
@@ -87,7 +87,7 @@ std::vector<cv::Point2f> normalisedRays(const std::vector<cv::Point>& pixels,
 // TUM's Kinect, up to half a frame apart) shows a moving object where it was or will be then,
 // off its labels by its image speed times the gap.
 struct LabelTiming {
-  double stamp = 0.0;               // the frame's time (s); frame to frame gives the speed
+  double stamp = 0.0;               // the labels' (colour image's) time (s): frame to frame, speed
   double depth_after_labels = 0.0;  // the depth image's stamp minus the labels' (s)
 };
 

@@ -28,7 +28,8 @@ class RgbdCloudBuilder {
 
   // Throws std::invalid_argument naming the problem: empty images, mismatched sizes, an
   // unsupported encoding, intrinsics that make no sense, or no pixel with valid depth.
-  // `stamp`: the frame's time (s), for the motion of labelled objects (depth_after_colour).
+  // `stamp`: the depth image's time (s), as the pipeline's (the colour image's is stamp -
+  // depth_after_colour), for the motion of labelled objects.
   LabeledCloud build(const RgbdFrame& frame, FrontendStats* stats = nullptr,
                      FrameImages* images = nullptr, double stamp = 0.0);
 
