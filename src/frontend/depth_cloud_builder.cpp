@@ -4,11 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <utility>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -201,8 +199,8 @@ LabelRegionMotions labelRegionMotions(const cv::Mat& previous, const cv::Mat& cu
   return out;
 }
 
-std::vector<DepthCloudBuilder::LabelShift> DepthCloudBuilder::labelShifts(
-    const cv::Mat& labels, cv::Size size, const LabelTiming& timing) {
+cv::Mat DepthCloudBuilder::labelsAtDepthInstant(const cv::Mat& labels, cv::Size size,
+                                                const LabelTiming& timing, int* moved_px) {
   // A quarter of the resolution (any labelled pixel marks its cell): a few tenths of a ms.
   constexpr int kScale = 4;
   const cv::Size cells((size.width + kScale - 1) / kScale, (size.height + kScale - 1) / kScale);
@@ -211,7 +209,10 @@ std::vector<DepthCloudBuilder::LabelShift> DepthCloudBuilder::labelShifts(
     cv::resize(labels, small, cells, 0, 0, cv::INTER_AREA);
     small = small > 0;
   }
-  std::vector<LabelShift> shifts;
+  cv::Mat at_depth_instant;  // empty while nothing is added
+  const auto add = [&](const cv::Mat& pixels) {
+    at_depth_instant = at_depth_instant.empty() ? pixels : (at_depth_instant | pixels);
+  };
   const double interval = timing.stamp - last_labels_stamp_;
   if (!last_labels_.empty() && last_labels_.size() == small.size() &&
       timing.depth_after_labels != 0.0 && interval > 0.0 && interval <= kMaxLabelInterval) {
@@ -228,19 +229,21 @@ std::vector<DepthCloudBuilder::LabelShift> DepthCloudBuilder::labelShifts(
       if (std::max(std::abs(shift.x), std::abs(shift.y)) <= options_.ignore_border_px) continue;
       cv::Mat pixels;  // the region's cells at the labels' resolution, then its labelled pixels
       cv::resize(motions.regions == static_cast<int>(r), pixels, size, 0, 0, cv::INTER_NEAREST);
-      shifts.push_back({pixels & labels, shift});
+      add(translated(pixels & labels, shift));
+      *moved_px = std::max(
+          *moved_px, static_cast<int>(std::lround(std::max(std::abs(shift.x), std::abs(shift.y)))));
     }
     // Depth older than the colour: what left the labels since the last frame (out of view, or
     // missed by the segmentation) may still be in the depth, near where it was labelled then.
     if (timing.depth_after_labels < 0.0 && cv::countNonZero(motions.vanished) > 0) {
       cv::Mat gone;
       cv::resize(motions.vanished, gone, size, 0, 0, cv::INTER_NEAREST);
-      shifts.push_back({gone, cv::Point2d(0.0, 0.0)});
+      add(gone);
     }
   }
   last_labels_ = cv::countNonZero(small) > 0 ? small : cv::Mat();
   last_labels_stamp_ = timing.stamp;
-  return shifts;
+  return at_depth_instant;
 }
 
 DepthCloudBuilder::DepthCloudBuilder(const CloudBuilderOptions& options)
@@ -287,13 +290,8 @@ LabeledCloud DepthCloudBuilder::build(const cv::Mat& image, const cv::Mat& depth
     if (cv::countNonZero(excluded) == 0) excluded.release();
     if (timing) {
       // Each region that moved further than the border reaches, also where the depth shows it.
-      cv::Mat at_depth_instant;
-      for (const LabelShift& region : labelShifts(excluded, image.size(), *timing)) {
-        const double shift = std::max(std::abs(region.shift.x), std::abs(region.shift.y));
-        const cv::Mat moved = shift > 0.0 ? translated(region.pixels, region.shift) : region.pixels;
-        at_depth_instant = at_depth_instant.empty() ? moved : (at_depth_instant | moved);
-        motion_px = std::max(motion_px, static_cast<int>(std::lround(shift)));
-      }
+      const cv::Mat at_depth_instant =
+          labelsAtDepthInstant(excluded, image.size(), *timing, &motion_px);
       if (!at_depth_instant.empty()) {
         excluded = excluded.empty() ? at_depth_instant : (excluded | at_depth_instant);
       }

@@ -133,15 +133,13 @@ class DepthCloudBuilder {
   // The last timed frame's ignored pixels (at a quarter of the resolution) and its stamp.
   cv::Mat last_labels_;
   double last_labels_stamp_ = 0.0;
-  // The labelled regions that moved since the last frame (LabelTiming), each with the shift (px)
-  // that puts it where the depth image shows it, and, where the depth is older than the colour,
-  // the last frame's regions gone from the labels (shift 0). Keeps `labels` for the next frame.
-  struct LabelShift {
-    cv::Mat pixels;  // the region's labelled pixels
-    cv::Point2d shift;
-  };
-  std::vector<LabelShift> labelShifts(const cv::Mat& labels, cv::Size size,
-                                      const LabelTiming& timing);
+  // The pixels where labelled regions are at the depth image's instant (LabelTiming): each
+  // region that moved since the last frame further than ignore_border_px takes in, moved by its
+  // motion over the gap (the largest shift, px, into *moved_px), and, where the depth is older
+  // than the colour, the last frame's regions gone from the labels. Empty when there are none.
+  // Keeps `labels` for the next frame.
+  cv::Mat labelsAtDepthInstant(const cv::Mat& labels, cv::Size size, const LabelTiming& timing,
+                               int* moved_px);
 };
 
 }  // namespace cvo
