@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cvo_odometry/core/intensity_image.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
 #include "cvo_odometry/core/motion_split.hpp"
 #include "cvo_odometry/core/pose_covariance.hpp"
@@ -499,6 +500,14 @@ void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval
   }
 }
 
+bool KeyframeOdometry::ignoredPixelsLeftOut(const LabeledCloud& cloud,
+                                            const OdometryFrame& frame) const {
+  const auto left_out = [](const LabeledCloud& c) {
+    return c.image() != nullptr && c.image()->hasExcludedPixels();
+  };
+  return frame.moving_classes_left_out || left_out(cloud) || left_out(*reference_);
+}
+
 KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, const Guess& guess,
                                                     const OdometryFrame& frame, double dt,
                                                     bool judge_view) {
@@ -507,9 +516,26 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   a.guess = guess.kind;
   // Without a motion guess the registration needs the wide first-frame lengthscale; a confident
   // feature prior is millimetres off and needs no wide basin.
-  a.result =
-      registration_.align(*reference_, cloud, guess.motion, guess.kind == GuessKind::kIdentity,
-                          guess.kind == GuessKind::kFeatures ? p.ell_prior : 0.0);
+  {
+    // Restores the parameters after a registration that ran with its own ell_min (also when it
+    // throws: a device failure without fallback).
+    struct Restore {
+      CvoRegistration& registration;
+      std::optional<CvoParams> params;
+      ~Restore() {
+        if (params) registration.setParams(*params);
+      }
+    } restore{registration_, std::nullopt};
+    if (p.ell_min_with_ignored > 0.0 && ignoredPixelsLeftOut(cloud, frame)) {
+      restore.params = p;
+      CvoParams ignoring = p;
+      ignoring.ell_min = p.ell_min_with_ignored;
+      registration_.setParams(ignoring);
+    }
+    a.result =
+        registration_.align(*reference_, cloud, guess.motion, guess.kind == GuessKind::kIdentity,
+                            guess.kind == GuessKind::kFeatures ? p.ell_prior : 0.0);
+  }
   const RegistrationReport& report = a.result.report;
   // cos = F_XZ / sqrt(F_XX F_ZZ). F_XZ comes with the report (the indicator times
   // sqrt(|X||Z|)); F_XX is cached per reference. No pairs in reach: nothing to take.

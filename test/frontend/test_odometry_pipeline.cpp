@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <optional>
 #include <random>
 
 #include <opencv2/imgproc.hpp>
 
+#include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
 #include "cvo_odometry/frontend/builtin_presets.hpp"
 #include "cvo_odometry/frontend/disparity_offset_calibration.hpp"
@@ -144,6 +146,59 @@ TEST(OdometryPipeline, AFullyMaskedFrameLeavesTheTracksToTheLastTrustedOne) {
       EXPECT_GE(result.update.track_agreement, 0.0) << "the tracks judged it";
     }
   }
+}
+
+// The fixture with labels of an ignored class over a third of the view, moving across it at
+// 9 px a frame (a person's labels without the person): each frame's registration, its rmse
+// frame to frame against the ground truth, and how many registrations ended at `ell`.
+struct LabelledRun {
+  double rmse_m = 0.0;
+  std::size_t frames = 0, trusted = 0, ended_at_ell = 0;
+};
+
+LabelledRun runWithMovingLabels(double ell_min_with_ignored, double ell) {
+  const cvo::TumSequence sequence(kTum);
+  cvo::OdometrySettings settings = tumSettings();
+  settings.cloud.semantic_classes = 2;
+  settings.cloud.ignore_classes = {1};
+  settings.cvo.ell_min_with_ignored = ell_min_with_ignored;
+  cvo::OdometryPipeline pipeline(settings);
+  cvo::Trajectory estimate;
+  LabelledRun run;
+  for (std::size_t k = 0; k < sequence.frames().size(); ++k) {
+    cvo::RgbdFrame frame = tumFrame(sequence, k);
+    frame.semantics = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+    const cv::Rect labelled(20 + 9 * static_cast<int>(k), 110, 300, 260);
+    frame.semantics(labelled & cv::Rect(cv::Point(0, 0), frame.semantics.size())).setTo(1);
+    const double stamp = sequence.frames()[k].depth_stamp;
+    const cvo::PipelineResult r = pipeline.process(stamp, frame);
+    EXPECT_EQ(r.outcome, cvo::FrameOutcome::kProcessed) << r.why;
+    estimate.append(stamp, r.update.pose);
+    if (k == 0) continue;
+    ++run.frames;
+    run.trusted += r.update.trusted();
+    run.ended_at_ell += std::abs(r.update.report.final_lengthscale - ell) < 1e-9;
+  }
+  const cvo::EvaluationReport report = cvo::evaluateTrajectory(
+      cvo::readTumTrajectory(kTum + "/groundtruth.txt"), estimate, cvo::EvaluationOptions{});
+  run.rmse_m = report.rpe_frame.translation_rmse;
+  return run;
+}
+
+// Proves: where ignored classes leave pixels out, registrations end at ell_min_with_ignored,
+// and on the fixture with moving labels that is the more accurate (measured 2.14 against
+// 3.06 mm frame to frame, every frame trusted against all but one; the same frames without
+// labels: 1.8 mm); 0 keeps ell_min.
+TEST(OdometryPipeline, RegistrationsBesideIgnoredClassesEndAtTheirOwnLengthscale) {
+  const LabelledRun at_ell_min = runWithMovingLabels(0.0, 0.02);
+  const LabelledRun smaller = runWithMovingLabels(0.0125, 0.0125);
+  std::cout << "moving labels: ell_min " << at_ell_min.rmse_m * 1000 << " mm, "
+            << at_ell_min.trusted << " trusted; ell_min_with_ignored " << smaller.rmse_m * 1000
+            << " mm, " << smaller.trusted << " trusted, of " << smaller.frames << "\n";
+  for (const LabelledRun* run : {&at_ell_min, &smaller})
+    EXPECT_GE(run->ended_at_ell, run->frames - 2) << "registrations that ended elsewhere";
+  EXPECT_EQ(smaller.trusted, smaller.frames);
+  EXPECT_LT(smaller.rmse_m, 0.9 * at_ell_min.rmse_m);
 }
 
 TEST(OdometryPipeline, BadInputIsClassifiedOnce) {
