@@ -38,10 +38,8 @@ void CvoParams::validate() const {
                                    std::to_string(ell_init) + ")");
   require(ell_min <= ell_first_frame, "ell_min > ell_first_frame");
   requirePositive(ell_prior, "ell_prior");  // below ell_min: ell_min (no annealing)
-  require(ell_min_with_ignored == 0.0 ||
-              (ell_min_with_ignored > 0.0 && ell_min_with_ignored <= ell_init &&
-               ell_min_with_ignored <= ell_first_frame),
-          "ell_min_with_ignored must be 0 (ell_min) or in (0, min(ell_init, ell_first_frame)]");
+  require(ell_min_ratio_with_ignored >= 0.01 && ell_min_ratio_with_ignored <= 1.0,
+          "ell_min_ratio_with_ignored must be in [0.01, 1]");
   if (use_color) {
     requirePositive(color_ell, "color_ell");
     requirePositive(color_sigma, "color_sigma");

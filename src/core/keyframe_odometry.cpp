@@ -526,10 +526,10 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
         if (params) registration.setParams(*params);
       }
     } restore{registration_, std::nullopt};
-    if (p.ell_min_with_ignored > 0.0 && ignoredPixelsLeftOut(cloud, frame)) {
+    if (p.ell_min_ratio_with_ignored < 1.0 && ignoredPixelsLeftOut(cloud, frame)) {
       restore.params = p;
       CvoParams ignoring = p;
-      ignoring.ell_min = p.ell_min_with_ignored;
+      ignoring.ell_min = p.ell_min * p.ell_min_ratio_with_ignored;
       registration_.setParams(ignoring);
     }
     a.result =

@@ -477,12 +477,13 @@ TEST(CvoParams, NonsenseIsRejectedWithTheParameterNamed) {
   p.ell_min = 0.5;
   EXPECT_NE(message(p).find("ell_min (0.500000) > ell_init (0.150000)"), std::string::npos);
   p = CvoParams();
-  p.ell_min_with_ignored = 0.5;
-  EXPECT_NE(message(p).find("ell_min_with_ignored must be 0"), std::string::npos);
-  p.ell_min_with_ignored = -0.01;
-  EXPECT_NE(message(p).find("ell_min_with_ignored must be 0"), std::string::npos);
-  p.ell_min_with_ignored = 0.0;
-  EXPECT_EQ(message(p), "") << "0: ell_min";
+  for (const double ratio : {0.0, 0.005, -0.5, 1.5}) {
+    p.ell_min_ratio_with_ignored = ratio;
+    EXPECT_NE(message(p).find("ell_min_ratio_with_ignored must be in [0.01, 1]"),
+              std::string::npos);
+  }
+  p.ell_min_ratio_with_ignored = 1.0;
+  EXPECT_EQ(message(p), "") << "1: ell_min";
   p = CvoParams();
   p.sp_ratio = 0.0;
   p.sp_thres = 0.02;  // s^2 = 0.01

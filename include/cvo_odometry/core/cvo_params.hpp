@@ -55,11 +55,11 @@ struct CvoParams {
   // clouds, and the indicator at the guess is its first sum (README "Motion prior").
   double ell_prior = 0.02;
   // Where ignored classes leave pixels out of a registration's clouds (the frame's or its
-  // reference's), the annealing ends here instead of at ell_min (0: at ell_min). On RGB-D the
-  // dense registration sets the translation, and with a third of the view left out it is the
-  // more accurate at a smaller lengthscale, where without labels it is the less accurate (doc/
+  // reference's), the annealing ends at ell_min times this (1: at ell_min). On RGB-D the dense
+  // registration sets the translation, and with a third of the view left out it is the more
+  // accurate at a smaller lengthscale, where without labels it is the less accurate (doc/
   // moving-objects.md "Lengthscale beside ignored classes").
-  double ell_min_with_ignored = 0.0125;
+  double ell_min_ratio_with_ignored = 0.625;
   double sigma = 0.1;
   // A pair counts when its kernel product a_ij exceeds the retain threshold: with sp_ratio > 0,
   // sp_ratio times the largest product the enabled kernels can give (sigma^2 color_sigma^2

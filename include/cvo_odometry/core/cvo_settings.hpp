@@ -25,11 +25,11 @@ void visitSettings(CvoParams& p, V&& v) {
                 "within millimetres, no wide basin is needed",
                 0.002, 2.0},
     p.ell_prior);
-  v(SettingInfo{"ell_min_with_ignored", "kernels",
-                "smallest lengthscale of a registration whose frame or reference has pixels of "
-                "ignore_classes left out (m; 0: ell_min)",
-                0.0, 1.0},
-    p.ell_min_with_ignored);
+  v(SettingInfo{"ell_min_ratio_with_ignored", "kernels",
+                "a registration whose frame or reference has pixels of ignore_classes left out "
+                "anneals to ell_min times this (1: ell_min)",
+                0.01, 1.0},
+    p.ell_min_ratio_with_ignored);
   v(SettingInfo{"sigma", "kernels", "geometric kernel amplitude s", 0.001, 10.0}, p.sigma);
   v(SettingInfo{"sp_ratio", "kernels",
                 "a pair counts only if its kernel product exceeds this fraction of the largest "

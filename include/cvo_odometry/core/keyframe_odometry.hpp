@@ -172,7 +172,7 @@ class KeyframeOdometry {
   Attempt attempt(const LabeledCloud& cloud, const Guess& guess, const OdometryFrame& frame,
                   double dt, bool judge_view = true);
   // The segmentation left pixels of ignored classes out of `cloud` (this frame's) or the
-  // reference: the registration then ends at ell_min_with_ignored.
+  // reference: the registration then ends at ell_min times ell_min_ratio_with_ignored.
   bool ignoredPixelsLeftOut(const LabeledCloud& cloud, const OdometryFrame& frame) const;
   // The guesses to try, in order, and those kept for a retry.
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
