@@ -18,6 +18,22 @@ int reflect(int i, int n) {
   return i < 0 ? -i : i >= n ? 2 * n - 2 - i : i;
 }
 
+// Raises most[x] to the response at (x, y) where the depth there is a number, for the rows
+// [y0, y1). Responses are >= 0 and finite, so they order as their bits do: an integer maximum,
+// element by element (it vectorises; a row's maximum, a reduction, stays scalar).
+void raiseColumnMaxima(const cv::Mat& response, const cv::Mat& depth, int y0, int y1,
+                       std::int32_t* __restrict most) {
+  const int w = response.cols;
+  for (int y = y0; y < y1; ++y) {
+    const std::int32_t* __restrict r = response.ptr<std::int32_t>(y);
+    const float* __restrict z = depth.ptr<float>(y);
+    for (int x = 0; x < w; ++x) {
+      const std::int32_t v = r[x] & -static_cast<std::int32_t>(z[x] == z[x]);
+      most[x] = std::max(most[x], v);
+    }
+  }
+}
+
 }  // namespace
 
 void MinEigenCorners::gradientProductRow(const cv::Mat& grey, int row, int slot) {
@@ -125,27 +141,13 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     responseRow(y, reflect(y - 1, h) % 3, reflect(y + 1, h) % 3);
   }
 
-  // The strongest response where corners may be; candidates: local maxima above the threshold.
-  // Responses are >= 0, and non-negative floats order as their bits do: an integer maximum
-  // (which vectorises).
-  std::int32_t strongest_bits = 0;
-  for (int y = first_row; y < h; ++y) {
-    const float* __restrict r = response_.ptr<float>(y);
-    const float* __restrict z = depth.ptr<float>(y);
-    for (int x = 0; x < w; ++x) {
-      std::int32_t bits;
-      std::memcpy(&bits, r + x, sizeof bits);
-      strongest_bits = std::max(strongest_bits, z[x] == z[x] ? bits : 0);
-    }
-  }
-  float strongest;
-  std::memcpy(&strongest, &strongest_bits, sizeof strongest);
-  const auto threshold = static_cast<float>(strongest * quality);
   // Spreading cells: square, grid_columns across the image, rows below first_row. Each cell's
   // corners are judged by its own strongest response (a high-contrast object elsewhere must not
   // lift the bar above a plainer background), but never below kCellQualityFloor of the image's.
+  // Responses are >= 0 and finite: 0 stands for none.
   int bucket_side = 0, bucket_columns = 0, bucket_cap = 0;
-  if (grid_columns > 0 && max_corners > 0) {
+  const bool spread = grid_columns > 0 && max_corners > 0;
+  if (spread) {
     bucket_side = std::max(1, (w + grid_columns - 1) / grid_columns);
     bucket_columns = (w + bucket_side - 1) / bucket_side;
     const int bucket_rows = (h - first_row + bucket_side - 1) / bucket_side;
@@ -153,20 +155,43 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     bucket_cap = std::max(1, (max_corners + buckets - 1) / buckets);
     bucket_counts_.assign(static_cast<std::size_t>(buckets), 0);
     bucket_threshold_.assign(static_cast<std::size_t>(buckets), 0.0f);
-    for (int y = first_row; y < h; ++y) {
-      const float* r = response_.ptr<float>(y);
-      const float* z = depth.ptr<float>(y);
-      float* cell_max = &bucket_threshold_[static_cast<std::size_t>((y - first_row) / bucket_side) *
-                                           bucket_columns];
-      for (int x = 0; x < w; ++x) {
-        if (z[x] == z[x]) cell_max[x / bucket_side] = std::max(cell_max[x / bucket_side], r[x]);
-      }
+  }
+  // The strongest response where corners may be, and each cell's: the columns' maxima over a
+  // row of cells (over all rows without cells), then over each cell's columns.
+  const auto as_float = [](std::int32_t bits) {
+    float value;
+    std::memcpy(&value, &bits, sizeof value);
+    return value;
+  };
+  float strongest = 0.0f;
+  std::vector<std::int32_t> column_max(static_cast<std::size_t>(w));
+  const int band = spread ? bucket_side : h - first_row;
+  for (int y0 = first_row; y0 < h; y0 += band) {
+    std::fill(column_max.begin(), column_max.end(), 0);
+    raiseColumnMaxima(response_, depth, y0, std::min(y0 + band, h), column_max.data());
+    if (!spread) {
+      strongest =
+          std::max(strongest, as_float(*std::max_element(column_max.begin(), column_max.end())));
+      continue;
     }
+    float* cell_max = &bucket_threshold_[static_cast<std::size_t>((y0 - first_row) / bucket_side) *
+                                         bucket_columns];
+    for (int c = 0; c < bucket_columns; ++c) {
+      const auto x = column_max.begin() + c * bucket_side;
+      cell_max[c] =
+          as_float(*std::max_element(x, column_max.begin() + std::min((c + 1) * bucket_side, w)));
+      strongest = std::max(strongest, cell_max[c]);
+    }
+  }
+  const auto threshold = static_cast<float>(strongest * quality);
+  if (spread) {
     const auto floor = static_cast<float>(strongest * quality * kCellQualityFloor);
     for (float& t : bucket_threshold_)
       t = std::max(static_cast<float>(t * quality), floor);
-    row_threshold_.resize(static_cast<std::size_t>(w));
   }
+  // Each pixel's bar in the row: its cell's, set again where a row of cells starts.
+  row_threshold_.assign(static_cast<std::size_t>(w), threshold);
+  int bar_cell_row = -1;
   candidates_.clear();
   is_peak_.resize(static_cast<std::size_t>(w));
   for (int y = std::max(first_row, 1); y + 1 < h; ++y) {
@@ -175,21 +200,23 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     const float* __restrict below = response_.ptr<float>(y + 1);
     const float* __restrict z = depth.ptr<float>(y);
     std::uint8_t* __restrict peak = is_peak_.data();
-    const float* __restrict bar = nullptr;
-    if (bucket_side > 0) {
+    if (bucket_side > 0 && (y - first_row) / bucket_side != bar_cell_row) {
+      bar_cell_row = (y - first_row) / bucket_side;
       const float* cell =
-          &bucket_threshold_[static_cast<std::size_t>((y - first_row) / bucket_side) *
-                             bucket_columns];
-      for (int x = 0; x < w; ++x)
-        row_threshold_[static_cast<std::size_t>(x)] = cell[x / bucket_side];
-      bar = row_threshold_.data();
+          &bucket_threshold_[static_cast<std::size_t>(bar_cell_row) * bucket_columns];
+      for (int c = 0; c < bucket_columns; ++c) {
+        const int x = c * bucket_side;
+        std::fill(row_threshold_.begin() + x, row_threshold_.begin() + std::min(x + bucket_side, w),
+                  cell[c]);
+      }
     }
+    const float* __restrict bar = row_threshold_.data();
     // Branch-free (it vectorises): above the threshold, with depth, no neighbour stronger.
     for (int x = 1; x + 1 < w; ++x) {
       const float v = r[x];
-      peak[x] = (v > (bar ? bar[x] : threshold)) & (z[x] == z[x]) & (v >= r[x - 1]) &
-                (v >= r[x + 1]) & (v >= above[x - 1]) & (v >= above[x]) & (v >= above[x + 1]) &
-                (v >= below[x - 1]) & (v >= below[x]) & (v >= below[x + 1]);
+      peak[x] = (v > bar[x]) & (z[x] == z[x]) & (v >= r[x - 1]) & (v >= r[x + 1]) &
+                (v >= above[x - 1]) & (v >= above[x]) & (v >= above[x + 1]) & (v >= below[x - 1]) &
+                (v >= below[x]) & (v >= below[x + 1]);
     }
     for (int x = 1; x + 1 < w;) {
       std::uint64_t eight;  // most pixels are no peak: skip them eight at a time
