@@ -500,12 +500,13 @@ void KeyframeOdometry::chooseGuesses(const OdometryFrame& frame, double interval
   }
 }
 
-bool KeyframeOdometry::ignoredPixelsLeftOut(const LabeledCloud& cloud,
-                                            const OdometryFrame& frame) const {
+bool KeyframeOdometry::ignoredPixelsLeftOut(const LabeledCloud& cloud) const {
+  // The cloud's image holds the mask its builder left out (the frame's moving_classes_left_out
+  // comes from the same mask); the reference's says the same of the keyframe.
   const auto left_out = [](const LabeledCloud& c) {
     return c.image() != nullptr && c.image()->hasExcludedPixels();
   };
-  return frame.moving_classes_left_out || left_out(cloud) || left_out(*reference_);
+  return left_out(cloud) || left_out(*reference_);
 }
 
 KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, const Guess& guess,
@@ -526,7 +527,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
         if (params) registration.setParams(*params);
       }
     } restore{registration_, std::nullopt};
-    if (p.ell_min_ratio_with_ignored < 1.0 && ignoredPixelsLeftOut(cloud, frame)) {
+    if (p.ell_min_ratio_with_ignored < 1.0 && ignoredPixelsLeftOut(cloud)) {
       restore.params = p;
       CvoParams ignoring = p;
       ignoring.ell_min = p.ell_min * p.ell_min_ratio_with_ignored;

@@ -173,7 +173,7 @@ class KeyframeOdometry {
                   double dt, bool judge_view = true);
   // The segmentation left pixels of ignored classes out of `cloud` (this frame's) or the
   // reference: the registration then ends at ell_min times ell_min_ratio_with_ignored.
-  bool ignoredPixelsLeftOut(const LabeledCloud& cloud, const OdometryFrame& frame) const;
+  bool ignoredPixelsLeftOut(const LabeledCloud& cloud) const;
   // The guesses to try, in order, and those kept for a retry.
   void chooseGuesses(const OdometryFrame& frame, double interval, std::vector<Guess>* first,
                      std::vector<Guess>* retries) const;
