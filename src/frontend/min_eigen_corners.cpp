@@ -164,22 +164,21 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     return value;
   };
   float strongest = 0.0f;
-  std::vector<std::int32_t> column_max(static_cast<std::size_t>(w));
   const int band = spread ? bucket_side : h - first_row;
   for (int y0 = first_row; y0 < h; y0 += band) {
-    std::fill(column_max.begin(), column_max.end(), 0);
-    raiseColumnMaxima(response_, depth, y0, std::min(y0 + band, h), column_max.data());
+    column_max_.assign(static_cast<std::size_t>(w), 0);
+    raiseColumnMaxima(response_, depth, y0, std::min(y0 + band, h), column_max_.data());
     if (!spread) {
       strongest =
-          std::max(strongest, as_float(*std::max_element(column_max.begin(), column_max.end())));
+          std::max(strongest, as_float(*std::max_element(column_max_.begin(), column_max_.end())));
       continue;
     }
     float* cell_max = &bucket_threshold_[static_cast<std::size_t>((y0 - first_row) / bucket_side) *
                                          bucket_columns];
     for (int c = 0; c < bucket_columns; ++c) {
-      const auto x = column_max.begin() + c * bucket_side;
+      const auto x = column_max_.begin() + c * bucket_side;
       cell_max[c] =
-          as_float(*std::max_element(x, column_max.begin() + std::min((c + 1) * bucket_side, w)));
+          as_float(*std::max_element(x, column_max_.begin() + std::min((c + 1) * bucket_side, w)));
       strongest = std::max(strongest, cell_max[c]);
     }
   }
@@ -200,7 +199,7 @@ const std::vector<cv::Point2f>& MinEigenCorners::find(const cv::Mat& grey, const
     const float* __restrict below = response_.ptr<float>(y + 1);
     const float* __restrict z = depth.ptr<float>(y);
     std::uint8_t* __restrict peak = is_peak_.data();
-    if (bucket_side > 0 && (y - first_row) / bucket_side != bar_cell_row) {
+    if (spread && (y - first_row) / bucket_side != bar_cell_row) {
       bar_cell_row = (y - first_row) / bucket_side;
       const float* cell =
           &bucket_threshold_[static_cast<std::size_t>(bar_cell_row) * bucket_columns];

@@ -44,7 +44,8 @@ class MinEigenCorners {
   std::vector<std::vector<cv::Point2f>> cells_;             // kept corners by grid cell
   std::vector<int> bucket_counts_;                          // kept corners by spreading cell
   std::vector<float> bucket_threshold_;                     // each spreading cell's least response
-  std::vector<float> row_threshold_;  // the least response of each pixel of a row
+  std::vector<float> row_threshold_;      // the least response of each pixel of a row
+  std::vector<std::int32_t> column_max_;  // each column's strongest response over a band (bits)
   std::vector<cv::Point2f> corners_;
 };
 
