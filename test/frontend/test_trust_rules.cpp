@@ -102,6 +102,36 @@ TEST(TrustRules, APoseTurnedFromTheTracksIsNotTrusted) {
   EXPECT_NE(off.problem.find("turns"), std::string::npos) << off.problem;
 }
 
+// With the moving classes left out of the frame by the segmentation, the tracks see only the
+// rest of the view and fix its turn less well: twice max_track_rotation_gap is allowed, and no
+// more.
+TEST(TrustRules, WithMovingClassesLeftOutTwiceTheTurnIsAllowed) {
+  TumTracked tum;
+  const cvo::MotionPrior real = tum.prior(0, 1);
+  ASSERT_TRUE(real.solved) << real.problem;
+  // The pixel bound wide enough for a turn past twice the gap to be judged by the turn alone.
+  cvo::CvoParams params = tum.params();
+  params.track_agreement_px = 25.0;
+  cvo::KeyframeOdometry within(params), beyond(params), unlabelled(params);
+  for (auto* odometry : {&within, &beyond, &unlabelled})
+    odometry->process(odometryFrame(0.0, tum.frame(0), {}));
+  cvo::OdometryFrame labelled = odometryFrame(kFrame, tum.frame(1), turned(real, 0.8));
+  labelled.moving_classes_left_out = true;
+  const cvo::OdometryUpdate kept = within.process(labelled);
+  EXPECT_TRUE(kept.trusted()) << kept.problem;
+  EXPECT_GT(kept.track_rotation_gap_deg, 0.5);
+  cvo::OdometryFrame far = odometryFrame(kFrame, tum.frame(1), turned(real, 1.3));
+  far.moving_classes_left_out = true;
+  const cvo::OdometryUpdate refused = beyond.process(far);
+  EXPECT_FALSE(refused.trusted());
+  EXPECT_NE(refused.problem.find("twice max_track_rotation_gap"), std::string::npos)
+      << refused.problem;
+  // The same turn without labels: refused at the gap itself.
+  const cvo::OdometryUpdate plain =
+      unlabelled.process(odometryFrame(kFrame, tum.frame(1), turned(real, 0.8)));
+  EXPECT_FALSE(plain.trusted());
+}
+
 // A frame lost for another reason (here a speed limit it breaks) is placed by its confident
 // tracks and becomes the reference; the next frame, with no tracks to judge its registration to
 // it, is not trusted there (its pose would be the guess's times a right motion) but registered

@@ -189,7 +189,7 @@ void visitSettings(CvoParams& p, V&& v) {
     p.min_track_agreement);
   v(SettingInfo{"max_track_rotation_gap", "tracking",
                 "a registration the tracks judge is trusted only if it turns within this (deg) of "
-                "their motion over the step",
+                "their motion over the step (twice this where the segmentation left pixels out)",
                 0.001, 180.0},
     p.max_track_rotation_gap);
   v(SettingInfo{"moving_track_agreement", "moving",
