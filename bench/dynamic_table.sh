@@ -10,8 +10,8 @@
 # frame before by > 1 deg, or by > half the step and > 2 cm; a pair across a restart is not
 # judged). Ours runs with lost_frame_policy publish_nothing, so that only trusted poses are in
 # its trajectory.
-# Usage: bench/dynamic_table.sh [--quick] [--extra] [--stride N] [--first N] [--check] [--no-peers]
-#                               [--tum DIR] [--kitti DIR] [--bin DIR]
+# Usage: bench/dynamic_table.sh [--quick] [--extra] [--stride N] [--first N] [--drop SHARE,SEED]
+#                               [--check] [--no-peers] [--tum DIR] [--kitti DIR] [--bin DIR]
 #   --quick     three TUM cases (the issue's person, a plain board without corners, and a
 #               checkerboard: a repeating texture), labelled and not; no peers (CI)
 #   --extra     more cases, made after the rules were set (other directions, a slow board, a
@@ -19,6 +19,8 @@
 #               near and coming closer, a checkered truck; and two objects at once)
 #   --stride N  every N-th frame (ours only: no peers)
 #   --first N   from the N-th frame on (0; ours only: no peers): other pairs of frames
+#   --drop SHARE,SEED  frames left out at random, as a busy driver drops them (cvo_run_sequence
+#               --drop; ours only: no peers): steps of several frames at random places
 #   --check     exit 1 when a run of ours has a silent failure, a labelled run loses a frame, or
 #               an unlabelled run of one object up to a third of the image trusts fewer than two
 #               thirds of the frames
@@ -28,7 +30,7 @@
 set -euo pipefail
 # shellcheck source=../scripts/env.sh
 source "$(dirname "$0")/../scripts/env.sh"
-quick=false more_cases=false check=false peers_on=true stride=1 first=0
+quick=false more_cases=false check=false peers_on=true stride=1 first=0 drop=
 tum=$CVO_ROOT/test/data/tum_fr1_xyz kitti=$CVO_ROOT/test/data/kitti_06_stereo
 bin=$CVO_BUILD/devel/lib/cvo_odometry
 while [ $# -gt 0 ]; do
@@ -37,12 +39,13 @@ while [ $# -gt 0 ]; do
     --extra) more_cases=true ;;
     --stride) stride=${2:-none}; [ $# -lt 2 ] || shift ;;
     --first) first=${2:-none}; [ $# -lt 2 ] || shift ;;
+    --drop) drop=${2:-}; [ $# -lt 2 ] || shift ;;
     --check) check=true ;;
     --no-peers) peers_on=false ;;
     --tum) tum=$2; shift ;;
     --kitti) kitti=$2; shift ;;
     --bin) bin=$2; shift ;;
-    *) sed -n '3,27p' "$0" >&2; exit 2 ;;
+    *) sed -n '3,29p' "$0" >&2; exit 2 ;;
   esac
   shift
 done
@@ -50,7 +53,9 @@ done
   { echo "dynamic_table: --stride takes a positive integer" >&2; exit 2; }
 [[ "$first" =~ ^[0-9]+$ ]] ||
   { echo "dynamic_table: --first takes a frame index (0 or more)" >&2; exit 2; }
-[ "$stride" = 1 ] && [ "$first" = 0 ] || peers_on=false
+[ "$stride" = 1 ] && [ "$first" = 0 ] && [ -z "$drop" ] || peers_on=false
+drop_args=()
+[ -z "$drop" ] || drop_args=(--drop "$drop")
 for tool in cvo_make_dynamic cvo_run_sequence cvo_evaluate; do
   [ -x "$bin/$tool" ] || { echo "dynamic_table: no $bin/$tool (build it, or --bin DIR)" >&2; exit 2; }
 done
@@ -185,7 +190,8 @@ run_case() {
       extra=(--segmentation "$dir/labels" --semantic-classes 2 --ignore-classes 1)
     # A run that trusts fewer than two frames has no error to evaluate: its cell says so.
     "$bin/cvo_run_sequence" "--$kind" "$dir" --gt "$gt" --quiet --set backend=cpu \
-      --stride "$stride" --first "$first" --lost-frame-policy publish_nothing "${extra[@]}" \
+      --stride "$stride" --first "$first" "${drop_args[@]}" --lost-frame-policy publish_nothing \
+      "${extra[@]}" \
       >"$work/$variant.log" 2>&1 ||
       grep -q "^tracking:" "$work/$variant.log" || { tail -5 "$work/$variant.log" >&2; exit 1; }
     ours+=("$(ours_cell "$work/$variant.log")")
@@ -219,7 +225,8 @@ run_case() {
 static_row() {
   local kind=$1 source=$2 gt=$3
   "$bin/cvo_run_sequence" "--$kind" "$source" --gt "$gt" --quiet --set backend=cpu \
-    --stride "$stride" --first "$first" --lost-frame-policy publish_nothing >"$work/static.log" 2>&1 ||
+    --stride "$stride" --first "$first" "${drop_args[@]}" --lost-frame-policy publish_nothing \
+    >"$work/static.log" 2>&1 ||
     { tail -5 "$work/static.log" >&2; exit 1; }
   local cell
   cell=$(ours_cell "$work/static.log")
@@ -239,7 +246,7 @@ if [ ${#kitti_cases[@]} -gt 0 ]; then
   done
 fi
 
-strided=$([ "$stride" = 1 ] || echo ", stride $stride")$([ "$first" = 0 ] || echo ", from frame $first")
+strided=$([ "$stride" = 1 ] || echo ", stride $stride")$([ "$first" = 0 ] || echo ", from frame $first")$([ -z "$drop" ] || echo ", frames dropped (--drop $drop)")
 echo "Moving objects ($(basename "$tum"), $(basename "$kitti")$strided): per run tracked/recovered/lost/" \
   "restarted frames, frame-to-frame error of trusted poses (mm / deg), silent failures"
 header="| case | object: share of image, motion | ours, no labels | ours, labelled |"

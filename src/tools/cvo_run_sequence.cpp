@@ -8,6 +8,9 @@
 #include <iomanip>
 #include <iostream>
 #include <optional>
+#include <random>
+#include <sstream>
+#include <vector>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
 #include "cvo_odometry/core/trajectory_io.hpp"
@@ -24,6 +27,9 @@ const char* kUsage =
     "usage: cvo_run_sequence (--tum DIR | --kitti DIR | --7scenes DIR) [options]\n"
     "  --first N --last N      frame range (0 .. all)\n"
     "  --stride N              every N-th frame of the range (larger motions per frame)\n"
+    "  --drop SHARE[,SEED]     leave out each frame after the first with probability SHARE\n"
+    "                          (0 <= SHARE < 1), as a busy driver or a slow link drops them;\n"
+    "                          the same SEED (1) leaves out the same frames\n"
     "  --out FILE --format tum|kitti   trajectory output (TUM for --tum, KITTI for --kitti)\n"
     "  --prior-out FILE        the feature prior's own trajectory, in the same format\n"
     "  --gt FILE               ground truth (TUM, or KITTI poses stamped by times.txt; 7-Scenes:\n"
@@ -53,6 +59,35 @@ class DepthRange {
   std::vector<float> depths_;
 };
 
+// The frames a run processes: every stride-th of [first, last], and of those after the first,
+// each left out with probability `drop` (a generator of its own, so the same seed drops the
+// same frames on every machine).
+std::vector<std::size_t> framesToRun(std::size_t first, std::size_t last, std::size_t stride,
+                                     double drop, unsigned seed) {
+  std::mt19937 draw(seed);
+  std::vector<std::size_t> frames;
+  for (std::size_t k = first; k <= last; k += stride) {
+    const double u = static_cast<double>(draw()) / 4294967296.0;  // [0, 1)
+    if (k == first || u >= drop) frames.push_back(k);
+  }
+  return frames;
+}
+
+// --drop SHARE[,SEED].
+void parseDrop(const std::string& text, double* share, unsigned* seed) {
+  std::istringstream in(text);
+  char comma = 0;
+  long long seed_value = 1;
+  in >> *share;
+  if (in && !in.eof() && in.peek() == ',') in >> comma >> seed_value;
+  if (!in || !in.eof() || !(*share >= 0.0 && *share < 1.0) || seed_value < 0 ||
+      seed_value > 4294967295LL) {
+    throw std::invalid_argument("--drop '" + text +
+                                "': a share in [0, 1), optionally ',SEED' (0 .. 2^32-1)");
+  }
+  *seed = static_cast<unsigned>(seed_value);
+}
+
 // A progress bar on the terminal (stderr).
 void progress(std::size_t done, std::size_t total, double fps) {
   const int width = 30;
@@ -69,7 +104,7 @@ int main(int argc, char** argv) {
   try {
     auto names = cvo::sharedOptionNames();
     names.insert(names.end(),
-                 {"first", "last", "stride", "out", "prior-out", "format", "gt", "plot"});
+                 {"first", "last", "stride", "drop", "out", "prior-out", "format", "gt", "plot"});
     const auto evaluation = cvo::evaluationOptionNames();
     names.insert(names.end(), evaluation.begin(), evaluation.end());
     const cvo::CommandLine cli(argc, argv, {names.begin(), names.end()}, {"help", "quiet"});
@@ -90,11 +125,15 @@ int main(int argc, char** argv) {
     if (first > last) throw std::invalid_argument("--first is after --last");
     const int stride = cli.getInt("stride", 1);
     if (stride < 1) throw std::invalid_argument("--stride must be >= 1");
+    double drop = 0.0;
+    unsigned drop_seed = 1;
+    if (cli.has("drop")) parseDrop(cli.get("drop"), &drop, &drop_seed);
+    const std::vector<std::size_t> frames =
+        framesToRun(first, last, static_cast<std::size_t>(stride), drop, drop_seed);
     const bool tty = isatty(STDERR_FILENO) && !cli.has("quiet");
-    std::cerr << "cvo_run_sequence: " << input.kind << ", " << (last - first) / stride + 1
-              << " frames, backend " << pipeline.backendName() << ", step "
-              << cvo::toString(params.step_method) << ", colour "
-              << (params.use_color ? "on" : "off") << "\n";
+    std::cerr << "cvo_run_sequence: " << input.kind << ", " << frames.size() << " frames, backend "
+              << pipeline.backendName() << ", step " << cvo::toString(params.step_method)
+              << ", colour " << (params.use_color ? "on" : "off") << "\n";
     std::cerr << "cvo_run_sequence: " << preset_note << "\n";
     if (!pipeline.backendNote().empty()) {
       std::cerr << "cvo_run_sequence: " << pipeline.backendNote() << "\n";
@@ -114,7 +153,8 @@ int main(int argc, char** argv) {
     // "Benchmark": about 1 with a core to itself, about 0.55 when sharing one with a busy loop).
     double cpu_ms_sum = 0.0, total_ms_sum = 0.0;
     std::size_t processed = 0, one_thread = 0;  // adaptive_threads: frames it ran on one thread
-    for (std::size_t k = first; k <= last; k += static_cast<std::size_t>(stride)) {
+    for (std::size_t done = 1; done <= frames.size(); ++done) {
+      const std::size_t k = frames[done - 1];
       const auto decode_start = std::chrono::steady_clock::now();
       const cvo::CameraFrame frame = input.frame(k);
       timer.add("decode", std::chrono::duration<double, std::milli>(
@@ -160,11 +200,10 @@ int main(int argc, char** argv) {
           total_ms_sum += result.total_ms;
         }
       }
-      const std::size_t done = (k - first) / stride + 1;
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (tty) {
-        progress(done, (last - first) / stride + 1, done / elapsed);
+        progress(done, frames.size(), done / elapsed);
       } else if (!cli.has("quiet")) {
         std::cerr << "frame " << k << ": ";
         if (result.outcome != cvo::FrameOutcome::kProcessed) {

@@ -41,4 +41,18 @@ if "$runner" --tum "$tum" --set backend=cpu --set num_threads=1 2>"$work/err.txt
   fail "a repeated --set accepted"
 fi
 grep -q "given twice" "$work/err.txt" || fail "unclear error: $(cat "$work/err.txt")"
+# --drop: frames left out at random, the same ones for the same seed, the first always kept.
+for run in a b; do
+  "$runner" --tum "$tum" --backend cpu --quiet --last 12 --drop 0.5,7 --out "$work/drop_$run.txt" \
+    >/dev/null 2>&1 || fail "--drop 0.5,7 did not run"
+done
+kept=$(grep -vc '^#' "$work/drop_a.txt")
+[ "$kept" -gt 1 ] && [ "$kept" -lt 13 ] || fail "--drop 0.5 kept $kept of 13 frames"
+cmp -s <(awk '!/^#/ { print $1 }' "$work/drop_a.txt") <(awk '!/^#/ { print $1 }' "$work/drop_b.txt") ||
+  fail "--drop 0.5,7 left out other frames on a second run"
+first=$(awk 'NR == 1 { print $3 }' "$tum/associations.txt")  # the depth stamps the poses
+[ "$(awk '!/^#/ { print $1; exit }' "$work/drop_a.txt")" = "$first" ] ||
+  fail "--drop left out the first frame"
+if "$runner" --tum "$tum" --drop 1 2>"$work/err.txt"; then fail "--drop 1 accepted"; fi
+grep -q "a share in \[0, 1)" "$work/err.txt" || fail "unclear error: $(cat "$work/err.txt")"
 echo "cvo_run_sequence: all checks passed"
