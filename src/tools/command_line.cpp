@@ -1,6 +1,5 @@
 #include "cvo_odometry/tools/command_line.hpp"
 
-#include <sstream>
 #include <stdexcept>
 
 namespace cvo {
@@ -66,18 +65,29 @@ int CommandLine::getInt(const std::string& name, int fallback) const {
 std::vector<double> CommandLine::getDoubleList(const std::string& name,
                                                const std::vector<double>& fallback) const {
   if (!has(name)) return fallback;
+  // Each item wholly a number: "0.4x" or a trailing comma is a typo, not 0.4.
+  const std::string text = get(name);
   std::vector<double> values;
-  std::stringstream ss(get(name));
-  std::string item;
-  while (std::getline(ss, item, ',')) {
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', begin);
+    const std::string item =
+        text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    std::size_t used = 0;
+    double value = 0.0;
     try {
-      values.push_back(std::stod(item));
+      value = std::stod(item, &used);
     } catch (const std::exception&) {
-      throw std::invalid_argument("--" + name + " expects comma-separated numbers, got '" +
-                                  get(name) + "'");
+      used = 0;
     }
+    if (item.empty() || used != item.size()) {
+      throw std::invalid_argument("--" + name + " expects comma-separated numbers, got '" + text +
+                                  "'");
+    }
+    values.push_back(value);
+    if (comma == std::string::npos) return values;
+    begin = comma + 1;
   }
-  return values;
 }
 
 }  // namespace cvo

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <iomanip>
 #include <iostream>
 #include <optional>
 #include <random>
-#include <sstream>
 #include <vector>
 
 #include "cvo_odometry/core/evaluation_report.hpp"
@@ -73,21 +73,6 @@ std::vector<std::size_t> framesToRun(std::size_t first, std::size_t last, std::s
   return frames;
 }
 
-// --drop SHARE[,SEED].
-void parseDrop(const std::string& text, double* share, unsigned* seed) {
-  std::istringstream in(text);
-  char comma = 0;
-  long long seed_value = 1;
-  in >> *share;
-  if (in && !in.eof() && in.peek() == ',') in >> comma >> seed_value;
-  if (!in || !in.eof() || !(*share >= 0.0 && *share < 1.0) || seed_value < 0 ||
-      seed_value > 4294967295LL) {
-    throw std::invalid_argument("--drop '" + text +
-                                "': a share in [0, 1), optionally ',SEED' (0 .. 2^32-1)");
-  }
-  *seed = static_cast<unsigned>(seed_value);
-}
-
 // A progress bar on the terminal (stderr).
 void progress(std::size_t done, std::size_t total, double fps) {
   const int width = 30;
@@ -125,11 +110,15 @@ int main(int argc, char** argv) {
     if (first > last) throw std::invalid_argument("--first is after --last");
     const int stride = cli.getInt("stride", 1);
     if (stride < 1) throw std::invalid_argument("--stride must be >= 1");
-    double drop = 0.0;
-    unsigned drop_seed = 1;
-    if (cli.has("drop")) parseDrop(cli.get("drop"), &drop, &drop_seed);
-    const std::vector<std::size_t> frames =
-        framesToRun(first, last, static_cast<std::size_t>(stride), drop, drop_seed);
+    const std::vector<double> drop = cli.getDoubleList("drop", {0.0, 1.0});  // SHARE[,SEED]
+    const double drop_seed = drop.size() == 2 ? drop[1] : 1.0;
+    if (drop.size() > 2 || !(drop[0] >= 0.0 && drop[0] < 1.0) || !(drop_seed >= 0.0) ||
+        drop_seed > 4294967295.0 || drop_seed != std::floor(drop_seed)) {
+      throw std::invalid_argument("--drop '" + cli.get("drop") +
+                                  "': a share in [0, 1), optionally ',SEED' (0 .. 2^32-1)");
+    }
+    const std::vector<std::size_t> frames = framesToRun(
+        first, last, static_cast<std::size_t>(stride), drop[0], static_cast<unsigned>(drop_seed));
     const bool tty = isatty(STDERR_FILENO) && !cli.has("quiet");
     std::cerr << "cvo_run_sequence: " << input.kind << ", " << frames.size() << " frames, backend "
               << pipeline.backendName() << ", step " << cvo::toString(params.step_method)

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -621,9 +622,10 @@ TEST(MakeDynamic, LabelledFramesAfterDroppedOnesAreNotTrustedOffTheirTurn) {
   int tracked = 0, recovered = 0;
   const std::size_t at = ran.output.find("tracking: ");
   ASSERT_NE(at, std::string::npos) << ran.output;
-  std::istringstream(ran.output.substr(at + 10)) >> tracked;
-  const std::size_t rec = ran.output.find(" tracked, ", at);
-  std::istringstream(ran.output.substr(rec + 10)) >> recovered;
+  ASSERT_EQ(std::sscanf(ran.output.c_str() + at, "tracking: %d tracked, %d recovered", &tracked,
+                        &recovered),
+            2)
+      << ran.output;
   EXPECT_GE(tracked + recovered, 6) << ran.output;
   fs::remove_all(out);
 }
