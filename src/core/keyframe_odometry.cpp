@@ -271,39 +271,18 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
     std::vector<double> errors(prediction_errors_px_.begin(), prediction_errors_px_.end());
     prediction_error_px = medianInPlace(errors);
   }
-  split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
-                        params().motion_split_ratio, predicted, prediction_error_px);
   if (thirdMotionSeparate(*frame.prior, params().min_prior_inliers, params().moving_min_px)) {
-    // Two objects besides the scene (two people, or one whose parts move apart): the scene is
-    // the first motion only where the two-motion evidence says so against each of the others.
-    MotionPrior with_third = *frame.prior;
-    with_third.second = MotionPrior::SecondMotion{};
-    with_third.second.solved = true;
-    with_third.second.motion = frame.prior->third.motion;
-    with_third.second.inliers = frame.prior->third.inliers;
-    const MotionSplit against_third =
-        splitMotions(with_third, params().motion_split_depth_ratio, params().motion_split_ratio,
-                     predicted, prediction_error_px);
-    std::ostringstream why;
-    why << "tracks split between three motions (" << frame.prior->inliers << ", "
-        << frame.prior->second.inliers << " and " << frame.prior->third.inliers << " tracks)";
-    if (split_->scene != SceneMotion::kFirst || against_third.scene != SceneMotion::kFirst) {
-      why << ": against the second, " << split_->why << "; against the third, "
-          << against_third.why;
-      split_ = MotionSplit{};
-      split_->why = why.str();
-      return split_->why;
-    }
-    // Both objects' tracks are the other motion's: their regions leave the cloud together.
-    for (std::size_t k = 0; k < split_->owner.size(); ++k) {
-      if (against_third.owner[k] == 1) split_->owner[k] = 1;
-    }
-    split_->second_tracks =
-        static_cast<int>(std::count(split_->owner.begin(), split_->owner.end(), 1));
-    split_->first_tracks =
-        static_cast<int>(std::count(split_->owner.begin(), split_->owner.end(), 0));
-    why << ": the scene follows the first against each of the others";
-    split_->why = why.str();
+    // Two objects besides the scene (two people, or one whose parts move apart): the scene
+    // follows the motion the two-motion evidence picks against each of the others, taken first.
+    MotionPrior scene_first;
+    split_ = splitThreeMotions(*frame.prior, params().motion_split_depth_ratio,
+                               params().motion_split_ratio, predicted, prediction_error_px,
+                               &scene_first);
+    if (split_->scene == SceneMotion::kUndecided) return split_->why;
+    frame.prior = std::move(scene_first);
+  } else {
+    split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
+                          params().motion_split_ratio, predicted, prediction_error_px);
   }
   if (split_->scene == SceneMotion::kUndecided) return split_->why;
   const std::string behind = judgeSceneBehind(frame, split_->scene == SceneMotion::kSecond);

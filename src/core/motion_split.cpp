@@ -1,8 +1,11 @@
 #include "cvo_odometry/core/motion_split.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "cvo_odometry/core/robust_scale.hpp"
 
@@ -192,6 +195,94 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
                               "constant-velocity prediction"
                             : ", and the constant-velocity prediction does not tell them apart");
   split.why = why.str();
+  return split;
+}
+
+MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
+                              const std::optional<Eigen::Isometry3d>& predicted,
+                              double prediction_error_px, MotionPrior* scene_prior) {
+  const std::array<Eigen::Isometry3d, 3> motions{prior.motion, prior.second.motion,
+                                                 prior.third.motion};
+  const std::array<int, 3> tracks{prior.inliers, prior.second.inliers, prior.third.inliers};
+  const std::array<const char*, 3> names{"first", "second", "third"};
+  // The prior with motions a and b as its first and second (the tracker's own second keeps what
+  // it knows of its tracks).
+  const auto pairOf = [&](int a, int b) {
+    MotionPrior pair = prior;
+    pair.motion = motions[a];
+    if (a != 0 || b != 1) {
+      pair.second = MotionPrior::SecondMotion{};
+      pair.second.solved = true;
+      pair.second.motion = motions[b];
+      pair.second.inliers = tracks[b];
+    }
+    return pair;
+  };
+  const std::array<std::pair<int, int>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
+  std::array<MotionSplit, 3> splits;
+  std::array<int, 3> wins{0, 0, 0};
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const auto [a, b] = pairs[i];
+    splits[i] =
+        splitMotions(pairOf(a, b), depth_ratio, lopsided_ratio, predicted, prediction_error_px);
+    if (splits[i].scene == SceneMotion::kFirst) ++wins[a];
+    if (splits[i].scene == SceneMotion::kSecond) ++wins[b];
+  }
+  std::ostringstream why;
+  why << "tracks split between three motions (" << tracks[0] << ", " << tracks[1] << " and "
+      << tracks[2] << " tracks)";
+  MotionSplit split;
+  const auto won = std::find(wins.begin(), wins.end(), 2);
+  if (won == wins.end()) {
+    why << ": none wins against each of the others";
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      why << "; " << names[pairs[i].first] << " against " << names[pairs[i].second] << ": "
+          << splits[i].why;
+    }
+    split.why = why.str();
+    return split;
+  }
+  const int scene = static_cast<int>(won - wins.begin());
+  // A track is the scene's where it explains it better than one other motion and no other
+  // motion explains it better.
+  split.owner.assign(prior.tracked_points.size(), -1);
+  std::vector<double> scene_depths, other_depths;
+  for (std::size_t k = 0; k < split.owner.size(); ++k) {
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const auto [a, b] = pairs[i];
+      if (a != scene && b != scene) continue;
+      const int mine = a == scene ? 0 : 1;
+      const int owner = splits[i].owner[k];
+      if (owner == 1 - mine) split.owner[k] = 1;
+      if (owner == mine && split.owner[k] < 0) split.owner[k] = 0;
+    }
+    if (split.owner[k] >= 0) {
+      (split.owner[k] == 0 ? scene_depths : other_depths).push_back(prior.tracked_points[k].z());
+    }
+  }
+  split.first_tracks = static_cast<int>(scene_depths.size());
+  split.second_tracks = static_cast<int>(other_depths.size());
+  if (!scene_depths.empty()) split.first_depth = medianInPlace(scene_depths);
+  if (!other_depths.empty()) split.second_depth = medianInPlace(other_depths);
+  split.scene = SceneMotion::kFirst;
+  why << ": the scene follows the " << names[scene] << ", which wins against each of the others";
+  split.why = why.str();
+  if (scene == 0) {
+    *scene_prior = prior;
+    return split;
+  }
+  // The others in their order: the first goes second, the remaining one third.
+  MotionPrior rebased = prior;
+  rebased.motion = motions[scene];
+  rebased.second = MotionPrior::SecondMotion{};
+  rebased.second.solved = true;
+  rebased.second.motion = motions[0];
+  rebased.second.inliers = tracks[0];
+  rebased.second.pixels = prior.inlier_pixels;
+  rebased.third.solved = true;
+  rebased.third.motion = motions[scene == 1 ? 2 : 1];
+  rebased.third.inliers = tracks[scene == 1 ? 2 : 1];
+  *scene_prior = std::move(rebased);
   return split;
 }
 

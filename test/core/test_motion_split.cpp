@@ -407,3 +407,95 @@ TEST(MotionSplit, TracksFollowingNoMotionFarBehindTheSceneMotionDoubtIt) {
   EXPECT_EQ(cvo::sceneBehindItsMotion(two.prior, true, min_tracks), "");
   EXPECT_EQ(cvo::sceneBehindItsMotion(two.prior, false, min_tracks), "");
 }
+
+namespace {
+
+// Two objects (1 m, a dense patch left of centre: most tracks; 1.5 m, right of centre) in front
+// of the background (4 m, sparse, all around them). PnP's order: the nearer object, the other,
+// then the background, the fewest.
+Scene twoObjects() {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d near = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
+  const Eigen::Isometry3d far = objectMotion(camera, Eigen::Vector3d(-0.04, 0.02, 0.0));
+  Scene scene = emptyScene(near, far);
+  scene.prior.third.solved = true;
+  scene.prior.third.motion = camera;
+  const auto inside = [](double u, double v) {
+    return v >= 155 && v <= 325 && ((u >= 115 && u <= 285) || (u >= 375 && u <= 525));
+  };
+  addTracks(&scene, near, 0, 120, 280, 160, 320, 10.0, 1.0);
+  addTracks(&scene, far, 1, 380, 520, 160, 320, 15.0, 1.5);
+  addTracks(&scene, camera, 2, 20, 620, 20, 460, 60.0, 4.0, inside);
+  scene.prior.inliers = count(scene.truth, 0);
+  scene.prior.second.inliers = count(scene.truth, 1);
+  scene.prior.third.inliers = count(scene.truth, 2);
+  return scene;
+}
+
+}  // namespace
+
+// Proves: with three motions, the scene is the one the two-motion rules pick against each of the
+// others, here the third (the background, behind both objects and the fewest tracks); the prior
+// comes back with it first, its own tracks the scene's and both objects' the other motion's.
+TEST(MotionSplit, OfThreeMotionsTheSceneIsTheOneThatWinsAgainstEach) {
+  const Scene scene = twoObjects();
+  ASSERT_LT(scene.prior.third.inliers, scene.prior.second.inliers);
+  cvo::MotionPrior scene_first;
+  const cvo::MotionSplit s =
+      cvo::splitThreeMotions(scene.prior, kParams.motion_split_depth_ratio,
+                             kParams.motion_split_ratio, std::nullopt, 0.0, &scene_first);
+  ASSERT_EQ(s.scene, cvo::SceneMotion::kFirst) << s.why;
+  EXPECT_NE(s.why.find("the third, which wins against each"), std::string::npos) << s.why;
+  EXPECT_TRUE(scene_first.motion.isApprox(cameraMotion(), 1e-12));
+  EXPECT_TRUE(scene_first.second.motion.isApprox(scene.prior.motion, 1e-12));
+  EXPECT_TRUE(scene_first.third.motion.isApprox(scene.prior.second.motion, 1e-12));
+  ASSERT_EQ(s.owner.size(), scene.truth.size());
+  for (std::size_t k = 0; k < s.owner.size(); ++k)
+    EXPECT_EQ(s.owner[k], scene.truth[k] == 2 ? 0 : 1) << "track " << k;
+  const cvo::MotionPrior out = cvo::sceneFirst(scene_first, s);
+  EXPECT_EQ(out.inliers, count(scene.truth, 2));
+  EXPECT_EQ(out.second.inliers, count(scene.truth, 0) + count(scene.truth, 1));
+  for (const Eigen::Vector3d& X : out.points)
+    EXPECT_NEAR(X.z(), 4.0, 1e-9);
+
+  // The background's motion first already: the prior comes back as it was.
+  Scene ordered = scene;
+  ordered.prior.motion = cameraMotion();
+  ordered.prior.third.motion = scene.prior.motion;
+  cvo::MotionPrior kept;
+  const cvo::MotionSplit t =
+      cvo::splitThreeMotions(ordered.prior, kParams.motion_split_depth_ratio,
+                             kParams.motion_split_ratio, std::nullopt, 0.0, &kept);
+  ASSERT_EQ(t.scene, cvo::SceneMotion::kFirst) << t.why;
+  EXPECT_NE(t.why.find("the first, which wins"), std::string::npos) << t.why;
+  EXPECT_TRUE(kept.motion.isApprox(cameraMotion(), 1e-12));
+  EXPECT_TRUE(kept.third.motion.isApprox(scene.prior.motion, 1e-12));
+}
+
+// Proves: three motions at similar depths, apart in the image, with as many tracks each: no pair
+// is decided, so none wins against each and the split is undecided with every pair's reason; the
+// prior handed in stays as it was.
+TEST(MotionSplit, ThreeMotionsNoneOfWhichWinsAgainstEachAreUndecided) {
+  const Eigen::Isometry3d camera = cameraMotion();
+  const Eigen::Isometry3d a = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
+  const Eigen::Isometry3d b = objectMotion(camera, Eigen::Vector3d(-0.05, 0.0, 0.0));
+  Scene scene = emptyScene(camera, a);
+  scene.prior.third.solved = true;
+  scene.prior.third.motion = b;
+  addTracks(&scene, camera, 0, 20, 120, 20, 120, 20.0, 2.0);
+  addTracks(&scene, a, 1, 260, 360, 20, 120, 20.0, 2.0);
+  addTracks(&scene, b, 2, 500, 600, 20, 120, 20.0, 2.0);
+  scene.prior.inliers = count(scene.truth, 0);
+  scene.prior.second.inliers = count(scene.truth, 1);
+  scene.prior.third.inliers = count(scene.truth, 2);
+  cvo::MotionPrior untouched;
+  untouched.inliers = -7;
+  const cvo::MotionSplit s =
+      cvo::splitThreeMotions(scene.prior, kParams.motion_split_depth_ratio,
+                             kParams.motion_split_ratio, std::nullopt, 0.0, &untouched);
+  EXPECT_EQ(s.scene, cvo::SceneMotion::kUndecided) << s.why;
+  EXPECT_NE(s.why.find("none wins against each"), std::string::npos) << s.why;
+  for (const char* pair : {"first against second", "first against third", "second against third"})
+    EXPECT_NE(s.why.find(pair), std::string::npos) << pair << ": " << s.why;
+  EXPECT_EQ(untouched.inliers, -7);
+}

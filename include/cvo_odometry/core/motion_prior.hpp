@@ -59,8 +59,8 @@ struct MotionPrior {
     bool apart_in_depth = false;
   } second;
   // A third motion among the tracks neither of those explains: two objects moving through the
-  // view (people walking past each other). The scene is the first only where the two-motion
-  // evidence (motion_split.hpp) picks it against each of the others.
+  // view (people walking past each other). The scene follows the one the two-motion evidence
+  // picks against each of the others (splitThreeMotions).
   struct ThirdMotion {
     bool solved = false;
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // previous <- current
