@@ -410,6 +410,19 @@ TEST(MotionSplit, TracksFollowingNoMotionFarBehindTheSceneMotionDoubtIt) {
 
 namespace {
 
+// A third motion for the scene's tracks labelled 2.
+void withThird(Scene* scene, const Eigen::Isometry3d& third) {
+  scene->prior.third.solved = true;
+  scene->prior.third.motion = third;
+}
+
+// Each motion's inlier count: its tracks (labels 0, 1 and 2).
+void countThreeMotions(Scene* scene) {
+  scene->prior.inliers = count(scene->truth, 0);
+  scene->prior.second.inliers = count(scene->truth, 1);
+  scene->prior.third.inliers = count(scene->truth, 2);
+}
+
 // Two objects (1 m, a dense patch left of centre: most tracks; 1.5 m, right of centre) in front
 // of the background (4 m, sparse, all around them). PnP's order: the nearer object, the other,
 // then the background, the fewest.
@@ -418,18 +431,20 @@ Scene twoObjects() {
   const Eigen::Isometry3d near = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
   const Eigen::Isometry3d far = objectMotion(camera, Eigen::Vector3d(-0.04, 0.02, 0.0));
   Scene scene = emptyScene(near, far);
-  scene.prior.third.solved = true;
-  scene.prior.third.motion = camera;
+  withThird(&scene, camera);
   const auto inside = [](double u, double v) {
     return v >= 155 && v <= 325 && ((u >= 115 && u <= 285) || (u >= 375 && u <= 525));
   };
   addTracks(&scene, near, 0, 120, 280, 160, 320, 10.0, 1.0);
   addTracks(&scene, far, 1, 380, 520, 160, 320, 15.0, 1.5);
   addTracks(&scene, camera, 2, 20, 620, 20, 460, 60.0, 4.0, inside);
-  scene.prior.inliers = count(scene.truth, 0);
-  scene.prior.second.inliers = count(scene.truth, 1);
-  scene.prior.third.inliers = count(scene.truth, 2);
+  countThreeMotions(&scene);
   return scene;
+}
+
+cvo::MotionSplit splitThree(const cvo::MotionPrior& prior, cvo::MotionPrior* scene_first) {
+  return cvo::splitThreeMotions(prior, kParams.motion_split_depth_ratio, kParams.motion_split_ratio,
+                                std::nullopt, 0.0, scene_first);
 }
 
 }  // namespace
@@ -441,9 +456,7 @@ TEST(MotionSplit, OfThreeMotionsTheSceneIsTheOneThatWinsAgainstEach) {
   const Scene scene = twoObjects();
   ASSERT_LT(scene.prior.third.inliers, scene.prior.second.inliers);
   cvo::MotionPrior scene_first;
-  const cvo::MotionSplit s =
-      cvo::splitThreeMotions(scene.prior, kParams.motion_split_depth_ratio,
-                             kParams.motion_split_ratio, std::nullopt, 0.0, &scene_first);
+  const cvo::MotionSplit s = splitThree(scene.prior, &scene_first);
   ASSERT_EQ(s.scene, cvo::SceneMotion::kFirst) << s.why;
   EXPECT_NE(s.why.find("the third, which wins against each"), std::string::npos) << s.why;
   EXPECT_TRUE(scene_first.motion.isApprox(cameraMotion(), 1e-12));
@@ -463,9 +476,7 @@ TEST(MotionSplit, OfThreeMotionsTheSceneIsTheOneThatWinsAgainstEach) {
   ordered.prior.motion = cameraMotion();
   ordered.prior.third.motion = scene.prior.motion;
   cvo::MotionPrior kept;
-  const cvo::MotionSplit t =
-      cvo::splitThreeMotions(ordered.prior, kParams.motion_split_depth_ratio,
-                             kParams.motion_split_ratio, std::nullopt, 0.0, &kept);
+  const cvo::MotionSplit t = splitThree(ordered.prior, &kept);
   ASSERT_EQ(t.scene, cvo::SceneMotion::kFirst) << t.why;
   EXPECT_NE(t.why.find("the first, which wins"), std::string::npos) << t.why;
   EXPECT_TRUE(kept.motion.isApprox(cameraMotion(), 1e-12));
@@ -480,19 +491,14 @@ TEST(MotionSplit, ThreeMotionsNoneOfWhichWinsAgainstEachAreUndecided) {
   const Eigen::Isometry3d a = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
   const Eigen::Isometry3d b = objectMotion(camera, Eigen::Vector3d(-0.05, 0.0, 0.0));
   Scene scene = emptyScene(camera, a);
-  scene.prior.third.solved = true;
-  scene.prior.third.motion = b;
+  withThird(&scene, b);
   addTracks(&scene, camera, 0, 20, 120, 20, 120, 20.0, 2.0);
   addTracks(&scene, a, 1, 260, 360, 20, 120, 20.0, 2.0);
   addTracks(&scene, b, 2, 500, 600, 20, 120, 20.0, 2.0);
-  scene.prior.inliers = count(scene.truth, 0);
-  scene.prior.second.inliers = count(scene.truth, 1);
-  scene.prior.third.inliers = count(scene.truth, 2);
+  countThreeMotions(&scene);
   cvo::MotionPrior untouched;
   untouched.inliers = -7;
-  const cvo::MotionSplit s =
-      cvo::splitThreeMotions(scene.prior, kParams.motion_split_depth_ratio,
-                             kParams.motion_split_ratio, std::nullopt, 0.0, &untouched);
+  const cvo::MotionSplit s = splitThree(scene.prior, &untouched);
   EXPECT_EQ(s.scene, cvo::SceneMotion::kUndecided) << s.why;
   EXPECT_NE(s.why.find("none wins against each"), std::string::npos) << s.why;
   for (const char* pair : {"first against second", "first against third", "second against third"})
