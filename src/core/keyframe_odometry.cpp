@@ -274,12 +274,8 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   if (thirdMotionSeparate(*frame.prior, params().min_prior_inliers, params().moving_min_px)) {
     // Two objects besides the scene (two people, or one whose parts move apart): the scene
     // follows the motion the two-motion evidence picks against each of the others, taken first.
-    MotionPrior scene_first;
-    split_ = splitThreeMotions(*frame.prior, params().motion_split_depth_ratio,
-                               params().motion_split_ratio, predicted, prediction_error_px,
-                               &scene_first);
-    if (split_->scene == SceneMotion::kUndecided) return split_->why;
-    frame.prior = std::move(scene_first);
+    split_ = splitThreeMotions(&*frame.prior, params().motion_split_depth_ratio,
+                               params().motion_split_ratio, predicted, prediction_error_px);
   } else {
     split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
                           params().motion_split_ratio, predicted, prediction_error_px);

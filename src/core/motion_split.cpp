@@ -198,33 +198,34 @@ MotionSplit splitMotions(const MotionPrior& prior, double depth_ratio, double lo
   return split;
 }
 
-MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
+MotionSplit splitThreeMotions(MotionPrior* prior, double depth_ratio, double lopsided_ratio,
                               const std::optional<Eigen::Isometry3d>& predicted,
-                              double prediction_error_px, MotionPrior* scene_prior) {
-  const std::array<Eigen::Isometry3d, 3> motions{prior.motion, prior.second.motion,
-                                                 prior.third.motion};
-  const std::array<int, 3> tracks{prior.inliers, prior.second.inliers, prior.third.inliers};
+                              double prediction_error_px) {
+  const std::array<Eigen::Isometry3d, 3> motions{prior->motion, prior->second.motion,
+                                                 prior->third.motion};
+  const std::array<int, 3> tracks{prior->inliers, prior->second.inliers, prior->third.inliers};
   const std::array<const char*, 3> names{"first", "second", "third"};
-  // The prior with motions a and b as its first and second (the tracker's own second keeps what
-  // it knows of its tracks).
-  const auto pairOf = [&](int a, int b) {
-    MotionPrior pair = prior;
-    pair.motion = motions[a];
-    if (a != 0 || b != 1) {
-      pair.second = MotionPrior::SecondMotion{};
-      pair.second.solved = true;
-      pair.second.motion = motions[b];
-      pair.second.inliers = tracks[b];
+  // One copy of the prior, given motions a and b as its first and second for each pair (the
+  // tracker's own second keeps what it knows of its tracks).
+  MotionPrior pair = *prior;
+  const auto setPair = [&](MotionPrior* out, int a, int b) {
+    out->motion = motions[a];
+    if (a == 0 && b == 1) {
+      out->second = prior->second;
+      return;
     }
-    return pair;
+    out->second = MotionPrior::SecondMotion{};
+    out->second.solved = true;
+    out->second.motion = motions[b];
+    out->second.inliers = tracks[b];
   };
   const std::array<std::pair<int, int>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
   std::array<MotionSplit, 3> splits;
   std::array<int, 3> wins{0, 0, 0};
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const auto [a, b] = pairs[i];
-    splits[i] =
-        splitMotions(pairOf(a, b), depth_ratio, lopsided_ratio, predicted, prediction_error_px);
+    setPair(&pair, a, b);
+    splits[i] = splitMotions(pair, depth_ratio, lopsided_ratio, predicted, prediction_error_px);
     if (splits[i].scene == SceneMotion::kFirst) ++wins[a];
     if (splits[i].scene == SceneMotion::kSecond) ++wins[b];
   }
@@ -245,7 +246,7 @@ MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, doub
   const int scene = static_cast<int>(won - wins.begin());
   // A track is the scene's where it explains it better than one other motion and no other
   // motion explains it better.
-  split.owner.assign(prior.tracked_points.size(), -1);
+  split.owner.assign(prior->tracked_points.size(), -1);
   std::vector<double> scene_depths, other_depths;
   for (std::size_t k = 0; k < split.owner.size(); ++k) {
     for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -257,7 +258,7 @@ MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, doub
       if (owner == mine && split.owner[k] < 0) split.owner[k] = 0;
     }
     if (split.owner[k] >= 0) {
-      (split.owner[k] == 0 ? scene_depths : other_depths).push_back(prior.tracked_points[k].z());
+      (split.owner[k] == 0 ? scene_depths : other_depths).push_back(prior->tracked_points[k].z());
     }
   }
   split.first_tracks = static_cast<int>(scene_depths.size());
@@ -267,22 +268,13 @@ MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, doub
   split.scene = SceneMotion::kFirst;
   why << ": the scene follows the " << names[scene] << ", which wins against each of the others";
   split.why = why.str();
-  if (scene == 0) {
-    *scene_prior = prior;
-    return split;
-  }
+  if (scene == 0) return split;
   // The others in their order: the first goes second, the remaining one third.
-  MotionPrior rebased = prior;
-  rebased.motion = motions[scene];
-  rebased.second = MotionPrior::SecondMotion{};
-  rebased.second.solved = true;
-  rebased.second.motion = motions[0];
-  rebased.second.inliers = tracks[0];
-  rebased.second.pixels = prior.inlier_pixels;
-  rebased.third.solved = true;
-  rebased.third.motion = motions[scene == 1 ? 2 : 1];
-  rebased.third.inliers = tracks[scene == 1 ? 2 : 1];
-  *scene_prior = std::move(rebased);
+  const int last = scene == 1 ? 2 : 1;
+  setPair(prior, scene, 0);
+  prior->second.pixels = prior->inlier_pixels;
+  prior->third.motion = motions[last];
+  prior->third.inliers = tracks[last];
   return split;
 }
 

@@ -442,9 +442,11 @@ Scene twoObjects() {
   return scene;
 }
 
+// splitThreeMotions on a copy of `prior`, which `*scene_first` receives as the split leaves it.
 cvo::MotionSplit splitThree(const cvo::MotionPrior& prior, cvo::MotionPrior* scene_first) {
-  return cvo::splitThreeMotions(prior, kParams.motion_split_depth_ratio, kParams.motion_split_ratio,
-                                std::nullopt, 0.0, scene_first);
+  *scene_first = prior;
+  return cvo::splitThreeMotions(scene_first, kParams.motion_split_depth_ratio,
+                                kParams.motion_split_ratio, std::nullopt, 0.0);
 }
 
 }  // namespace
@@ -485,7 +487,7 @@ TEST(MotionSplit, OfThreeMotionsTheSceneIsTheOneThatWinsAgainstEach) {
 
 // Proves: three motions at similar depths, apart in the image, with as many tracks each: no pair
 // is decided, so none wins against each and the split is undecided with every pair's reason; the
-// prior handed in stays as it was.
+// prior keeps its order.
 TEST(MotionSplit, ThreeMotionsNoneOfWhichWinsAgainstEachAreUndecided) {
   const Eigen::Isometry3d camera = cameraMotion();
   const Eigen::Isometry3d a = objectMotion(camera, Eigen::Vector3d(0.05, 0.0, 0.0));
@@ -496,12 +498,16 @@ TEST(MotionSplit, ThreeMotionsNoneOfWhichWinsAgainstEachAreUndecided) {
   addTracks(&scene, a, 1, 260, 360, 20, 120, 20.0, 2.0);
   addTracks(&scene, b, 2, 500, 600, 20, 120, 20.0, 2.0);
   countThreeMotions(&scene);
-  cvo::MotionPrior untouched;
-  untouched.inliers = -7;
-  const cvo::MotionSplit s = splitThree(scene.prior, &untouched);
+  cvo::MotionPrior after;
+  const cvo::MotionSplit s = splitThree(scene.prior, &after);
   EXPECT_EQ(s.scene, cvo::SceneMotion::kUndecided) << s.why;
   EXPECT_NE(s.why.find("none wins against each"), std::string::npos) << s.why;
   for (const char* pair : {"first against second", "first against third", "second against third"})
     EXPECT_NE(s.why.find(pair), std::string::npos) << pair << ": " << s.why;
-  EXPECT_EQ(untouched.inliers, -7);
+  EXPECT_TRUE(after.motion.matrix() == scene.prior.motion.matrix());
+  EXPECT_TRUE(after.second.motion.matrix() == scene.prior.second.motion.matrix());
+  EXPECT_TRUE(after.third.motion.matrix() == scene.prior.third.motion.matrix());
+  EXPECT_EQ(after.inliers, scene.prior.inliers);
+  EXPECT_EQ(after.second.inliers, scene.prior.second.inliers);
+  EXPECT_EQ(after.third.inliers, scene.prior.third.inliers);
 }

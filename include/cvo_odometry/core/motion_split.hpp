@@ -59,11 +59,11 @@ bool thirdMotionSeparate(const MotionPrior& prior, int min_tracks, double moving
 // Three motions (the prior's third solved: two objects, or one whose parts move apart): the scene
 // follows the motion that splitMotions, with the same arguments, picks against each of the other
 // two. Then the split's scene is kFirst, its owner 1 for the tracks either other motion explains
-// better, and `*scene_prior` the prior with that motion first and the others after it, in their
-// order; else undecided, with each pair's reasons, and `*scene_prior` untouched.
-MotionSplit splitThreeMotions(const MotionPrior& prior, double depth_ratio, double lopsided_ratio,
+// better, and `*prior` reordered in place: that motion first, the others after it in their order.
+// Else undecided, with each pair's reasons, and `*prior` as it was.
+MotionSplit splitThreeMotions(MotionPrior* prior, double depth_ratio, double lopsided_ratio,
                               const std::optional<Eigen::Isometry3d>& predicted,
-                              double prediction_error_px, MotionPrior* scene_prior);
+                              double prediction_error_px);
 
 // Why the scene may not follow the motion it is taken to (the prior's first, or its second
 // where `scene_is_second`): at least `min_tracks` tracks, and a fifth as many as that motion's
