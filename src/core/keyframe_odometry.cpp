@@ -1054,6 +1054,11 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     setReference(frame.cloud, update.stamp);
     reference_guessed_ = true;
     update.new_keyframe = reference_ != nullptr;
+    // Its corners too: the next frame's tracks start here, from the pose the prior placed it at
+    // (priorFramePose). From the last good frame, two steps back, they outgrow KLT first (KITTI
+    // 06 at stride 5, 6 m a step: 5 of 9 frames lost, then a restart; 1 of 10 lost from here).
+    update.restart_tracks = true;
+    frames_since_anchor_ = 0;
     return;
   }
   // Keep the reference: the next frame is registered to the last good one.

@@ -87,8 +87,9 @@ struct OdometryUpdate {
   std::string motion_split;  // how the scene's motion was told from the object's, if it was
   // The object's region in this frame's image (left out of its cloud), or null.
   std::shared_ptr<const PixelRegion> moving_region;
-  // The next frame's feature tracks start from this one: a trusted frame, or a restart (beside
-  // something moving, one whose last trusted frame is too far back for its tracks to judge;
+  // The next frame's feature tracks start from this one: a trusted frame, a lost one placed by a
+  // confident prior that the next frame is registered to, or a restart (beside something moving,
+  // one whose last trusted frame is too far back for its tracks to judge;
   // FeatureTracker::frameJudged). Else from the last such frame.
   bool restart_tracks = false;
   // In the base frame (REP-105: odom <- base_link), base = base_from_camera of the trajectory.
