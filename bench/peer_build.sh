@@ -6,7 +6,8 @@
 # shellcheck shell=bash
 
 peer_build() {
-  "$CVO_ROOT/scripts/install_deps.sh" peers
+  # Its messages to stderr: the callers' standard output is a generated table.
+  "$CVO_ROOT/scripts/install_deps.sh" peers >&2
   local build="$CVO_ROOT/build/peers"
   mkdir -p "$build"
   # Release and no ROS: the timings are of the optimised tools, not of a debug or ROS build.
