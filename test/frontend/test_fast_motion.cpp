@@ -311,6 +311,14 @@ class ShiftedSourceBackend : public cvo::RegistrationBackend {
   cvo::LabeledCloud shifted_;
 };
 
+// A CPU backend that shifts the source while `*wrong` holds.
+cvo::OdometryPipeline::BackendFactory shiftedWhile(const std::shared_ptr<const bool>& wrong) {
+  return [wrong](const cvo::CvoParams& p) -> std::unique_ptr<cvo::RegistrationBackend> {
+    return std::make_unique<ShiftedSourceBackend>(std::make_unique<cvo::CpuBackend>(p.num_threads),
+                                                  wrong);
+  };
+}
+
 // A frame whose registration fails while its feature prior is confident is lost, placed by the
 // prior, and becomes the next frame's reference: one step away, instead of a last good frame that
 // falls further behind with each lost frame (at KITTI stride 3 one lost frame used to lose the
@@ -324,11 +332,7 @@ TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
   settings.cvo.backend = cvo::BackendChoice::kCpu;
   settings.cvo.lost_frame_policy = GetParam();
   auto wrong = std::make_shared<bool>(false);
-  cvo::OdometryPipeline pipeline(
-      settings, [wrong](const cvo::CvoParams& p) -> std::unique_ptr<cvo::RegistrationBackend> {
-        return std::make_unique<ShiftedSourceBackend>(
-            std::make_unique<cvo::CpuBackend>(p.num_threads), wrong);
-      });
+  cvo::OdometryPipeline pipeline(settings, shiftedWhile(wrong));
   constexpr std::size_t kLostFrame = 3;
   std::shared_ptr<const cvo::LabeledCloud> lost_cloud;
   OdometryRun out;
@@ -371,11 +375,7 @@ TEST(LostFrames, TheTracksOfTheFrameAfterALostOneStartFromIt) {
   settings.cvo.backend = cvo::BackendChoice::kCpu;
   settings.cvo.lost_frame_policy = cvo::LostFramePolicy::kPublishNothing;
   auto wrong = std::make_shared<bool>(false);
-  cvo::OdometryPipeline pipeline(
-      settings, [wrong](const cvo::CvoParams& p) -> std::unique_ptr<cvo::RegistrationBackend> {
-        return std::make_unique<ShiftedSourceBackend>(
-            std::make_unique<cvo::CpuBackend>(p.num_threads), wrong);
-      });
+  cvo::OdometryPipeline pipeline(settings, shiftedWhile(wrong));
   constexpr std::size_t kStride = 3, kLostFrame = 3;
   double lost_stamp = 0.0;
   OdometryRun out;
