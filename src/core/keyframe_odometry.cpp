@@ -185,6 +185,11 @@ std::string KeyframeOdometry::recoveredPoseProblem(
   return why.str();
 }
 
+void KeyframeOdometry::tracksStartHere(OdometryUpdate& update) {
+  update.restart_tracks = true;
+  frames_since_anchor_ = 0;
+}
+
 bool KeyframeOdometry::movedLately(double stamp) const {
   return moving_seen_stamp_ && stamp - *moving_seen_stamp_ <= kMovingMemorySeconds;
 }
@@ -895,9 +900,8 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
 
 OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
-  frames_since_anchor_ = 0;
   OdometryUpdate update;
-  update.restart_tracks = true;
+  tracksStartHere(update);
   update.stamp = frame.stamp;
   update.state = TrackingState::kFirstFrame;
   update.pose = pose_;
@@ -1031,9 +1035,8 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // guess and no judge until the motion was 2 s in the past (a van crossing: 20 of 50 frames
     // lost, 4 restarts).
     const bool moving_lately = movedLately(frame.stamp);
-    update.restart_tracks = !moving_lately || frames_since_anchor_ > p.max_lost_frames;
-    if (update.restart_tracks) {
-      frames_since_anchor_ = 0;
+    if (!moving_lately || frames_since_anchor_ > p.max_lost_frames) {
+      tracksStartHere(update);
       // As a first frame: the stretch's origin is the frame the next ones' tracks start from
       // (priorFramePose), so they guess and judge at once; the last good frame before the
       // restart is no fallback for frames of the new stretch.
@@ -1057,8 +1060,7 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // Its corners too: the next frame's tracks start here, from the pose the prior placed it at
     // (priorFramePose). From the last good frame, two steps back, they outgrow KLT first (KITTI
     // 06 at stride 5, 6 m a step: 5 of 9 frames lost, then a restart; 1 of 10 lost from here).
-    update.restart_tracks = true;
-    frames_since_anchor_ = 0;
+    tracksStartHere(update);
     return;
   }
   // Keep the reference: the next frame is registered to the last good one.

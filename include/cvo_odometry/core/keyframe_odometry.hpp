@@ -208,6 +208,9 @@ class KeyframeOdometry {
   // Why the scene may not follow the motion it is taken to (sceneBehindItsMotion), kept as an
   // undecided split; empty when nothing says so.
   std::string judgeSceneBehind(const OdometryFrame& frame, bool scene_is_second);
+  // The next frame's tracks start from this one (update.restart_tracks), and the frames since
+  // their start are counted from it.
+  void tracksStartHere(OdometryUpdate& update);
   // Enough inliers to contradict a registration, even at a ratio too low to be a guess.
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
@@ -280,7 +283,8 @@ class KeyframeOdometry {
   Eigen::Isometry3d last_trusted_pose_ = Eigen::Isometry3d::Identity();
   std::optional<double> last_trusted_stamp_;
   int lost_frames_ = 0;
-  // Frames since the one the feature tracks start from (the last trusted one, or a restart).
+  // Frames since the one the feature tracks start from (the last trusted one, a lost one placed by
+  // its prior, or a restart).
   int frames_since_anchor_ = 0;
   bool previous_placed_by_prior_ = false;  // the last lost frame's pose came from the prior
   bool started_ = false;
