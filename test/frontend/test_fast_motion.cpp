@@ -319,6 +319,34 @@ cvo::OdometryPipeline::BackendFactory shiftedWhile(const std::shared_ptr<const b
   };
 }
 
+// The bundled KITTI excerpt, every `stride`-th frame, with the registration of frame `lost_frame`
+// failed (ShiftedSourceBackend): each frame's index and result, and the run's poses.
+struct LostFrameRun {
+  std::vector<std::size_t> frames;
+  std::vector<cvo::PipelineResult> results;
+  OdometryRun poses;
+};
+
+LostFrameRun runWithLostFrame(const Fixture& fixture, cvo::LostFramePolicy policy,
+                              std::size_t stride, std::size_t lost_frame) {
+  cvo::OdometrySettings settings;
+  cvo::applyPreset(fixture.preset, &settings);
+  settings.cvo.backend = cvo::BackendChoice::kCpu;
+  settings.cvo.lost_frame_policy = policy;
+  auto wrong = std::make_shared<bool>(false);
+  cvo::OdometryPipeline pipeline(settings, shiftedWhile(wrong));
+  LostFrameRun out;
+  for (std::size_t k = 0; k < fixture.stamps.size(); k += stride) {
+    *wrong = k == lost_frame;
+    cvo::PipelineResult r = pipeline.process(fixture.stamps[k], fixture.frame(k));
+    if (r.update.has_pose) out.poses.estimate.append(fixture.stamps[k], r.update.pose);
+    if (r.update.trusted()) out.poses.trusted.push_back(fixture.stamps[k]);
+    out.frames.push_back(k);
+    out.results.push_back(std::move(r));
+  }
+  return out;
+}
+
 // A frame whose registration fails while its feature prior is confident is lost, placed by the
 // prior, and becomes the next frame's reference: one step away, instead of a last good frame that
 // falls further behind with each lost frame (at KITTI stride 3 one lost frame used to lose the
@@ -327,20 +355,12 @@ class LostFramePolicies : public testing::TestWithParam<cvo::LostFramePolicy> {}
 
 TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
   const Fixture fixture = kitti();
-  cvo::OdometrySettings settings;
-  cvo::applyPreset(fixture.preset, &settings);
-  settings.cvo.backend = cvo::BackendChoice::kCpu;
-  settings.cvo.lost_frame_policy = GetParam();
-  auto wrong = std::make_shared<bool>(false);
-  cvo::OdometryPipeline pipeline(settings, shiftedWhile(wrong));
   constexpr std::size_t kLostFrame = 3;
+  const LostFrameRun run = runWithLostFrame(fixture, GetParam(), 1, kLostFrame);
   std::shared_ptr<const cvo::LabeledCloud> lost_cloud;
-  OdometryRun out;
-  for (std::size_t k = 0; k < fixture.stamps.size(); ++k) {
-    *wrong = k == kLostFrame;
-    const cvo::PipelineResult r = pipeline.process(fixture.stamps[k], fixture.frame(k));
-    if (r.update.has_pose) out.estimate.append(fixture.stamps[k], r.update.pose);
-    if (r.update.trusted()) out.trusted.push_back(fixture.stamps[k]);
+  for (std::size_t i = 0; i < run.results.size(); ++i) {
+    const std::size_t k = run.frames[i];
+    const cvo::PipelineResult& r = run.results[i];
     if (k == kLostFrame) {
       EXPECT_EQ(r.update.state, cvo::TrackingState::kLost) << r.update.problem;
       // It is lost all the same: the policy says whether its (the prior's) pose is published.
@@ -355,9 +375,9 @@ TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
       EXPECT_EQ(r.reference, lost_cloud);
     }
   }
-  const auto report = evaluate(fixture, out);
+  const auto report = evaluate(fixture, run.poses);
   print("kitti, frame 3 lost", report);
-  EXPECT_EQ(out.trusted.size(), fixture.stamps.size() - 1);
+  EXPECT_EQ(run.poses.trusted.size(), fixture.stamps.size() - 1);
   EXPECT_EQ(report.silent.failures, 0u);
   // The whole trajectory, the prior's placement of the lost frame included, stays close.
   EXPECT_LT(report.ate.rmse, 0.1);
@@ -370,20 +390,13 @@ TEST_P(LostFramePolicies, AFrameLostWithAConfidentPriorIsTheNextOnesReference) {
 // start is what the change sets.
 TEST(LostFrames, TheTracksOfTheFrameAfterALostOneStartFromIt) {
   const Fixture fixture = kitti();
-  cvo::OdometrySettings settings;
-  cvo::applyPreset(fixture.preset, &settings);
-  settings.cvo.backend = cvo::BackendChoice::kCpu;
-  settings.cvo.lost_frame_policy = cvo::LostFramePolicy::kPublishNothing;
-  auto wrong = std::make_shared<bool>(false);
-  cvo::OdometryPipeline pipeline(settings, shiftedWhile(wrong));
   constexpr std::size_t kStride = 3, kLostFrame = 3;
+  const LostFrameRun run =
+      runWithLostFrame(fixture, cvo::LostFramePolicy::kPublishNothing, kStride, kLostFrame);
   double lost_stamp = 0.0;
-  OdometryRun out;
-  for (std::size_t k = 0; k < fixture.stamps.size(); k += kStride) {
-    *wrong = k == kLostFrame;
-    const cvo::PipelineResult r = pipeline.process(fixture.stamps[k], fixture.frame(k));
-    if (r.update.has_pose) out.estimate.append(fixture.stamps[k], r.update.pose);
-    if (r.update.trusted()) out.trusted.push_back(fixture.stamps[k]);
+  for (std::size_t i = 0; i < run.results.size(); ++i) {
+    const std::size_t k = run.frames[i];
+    const cvo::PipelineResult& r = run.results[i];
     if (k == kLostFrame) {
       EXPECT_EQ(r.update.state, cvo::TrackingState::kLost) << r.update.problem;
       lost_stamp = fixture.stamps[k];
@@ -397,9 +410,9 @@ TEST(LostFrames, TheTracksOfTheFrameAfterALostOneStartFromIt) {
       EXPECT_TRUE(r.prior->solved);
     }
   }
-  const auto report = evaluate(fixture, out);
+  const auto report = evaluate(fixture, run.poses);
   print("kitti stride 3, frame 3 lost", report);
-  EXPECT_EQ(out.trusted.size(), (fixture.stamps.size() + kStride - 1) / kStride - 1);
+  EXPECT_EQ(run.poses.trusted.size(), (fixture.stamps.size() + kStride - 1) / kStride - 1);
   EXPECT_EQ(report.silent.failures, 0u);
 }
 
