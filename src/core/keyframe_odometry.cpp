@@ -67,6 +67,30 @@ double angleDeg(const Eigen::Isometry3d& T) {
   return lie::rotationAngle(T.rotation()) * 180.0 / M_PI;
 }
 
+// An image whose intensities spread less than this (0..1, standard deviation) has no texture to
+// anchor tracks: a black frame, a saturated one, a cap on the lens.
+constexpr double kMinAnchorContrast = 2.0 / 255.0;
+
+// False for a frame whose grey image is (nearly) uniform; true without an image to tell.
+bool imageHasContrast(const LabeledCloud& cloud) {
+  const IntensityImage* image = cloud.image();
+  if (!image || image->levelCount() == 0) return true;
+  constexpr int kStep = 16;  // px between samples: the spread, not the detail
+  double sum = 0.0, squares = 0.0;
+  int n = 0;
+  for (int v = kStep / 2; v + 2 < image->height(); v += kStep) {
+    for (int u = kStep / 2; u + 2 < image->width(); u += kStep) {
+      const double i = image->intensity(0, u, v);
+      sum += i;
+      squares += i * i;
+      ++n;
+    }
+  }
+  if (n < 2) return true;
+  const double mean = sum / n;
+  return squares / n - mean * mean >= kMinAnchorContrast * kMinAnchorContrast;
+}
+
 }  // namespace
 
 std::string toString(TrackingState state) {
@@ -743,6 +767,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   checkStamp(frame.stamp);
   source_self_.reset();
   const std::size_t cloud_points = frame.cloud ? frame.cloud->size() : 0;
+  frame_has_tracks_ = frame.prior.has_value();  // before priorFramePose may drop them
   if (!started_) {
     base_from_camera_ = frame.base_from_camera;
     started_ = true;
@@ -1006,8 +1031,17 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
                              : stillMotion();
   const Matrix6d guessed = guessedMotionCovariance(p, update.frame_interval);
   const Eigen::Isometry3d previous = pose_;
-  const bool restart =
-      p.lost_frame_policy == LostFramePolicy::kReset || lost_frames_ > p.max_lost_frames;
+  // Once a second frame in a row finds no motion in its tracks from the last anchor, the frames
+  // after it, further away, find none either: restart here, where the next frames' tracks start,
+  // rather than after max_lost_frames (KITTI with 40 % of the frames dropped and a car crossing:
+  // 5 lost and a restart -> 1 and a restart). Not without tracks (no feature prior, nothing
+  // usable in the frame), nor in an image without contrast (black, a cap on the lens): such a
+  // frame is no anchor, and the next one may reach the last good frame.
+  const bool tracks_out_of_reach = lost_frames_ >= 2 && frame_has_tracks_ &&
+                                   !priorJudges(frame.prior) && frame.cloud &&
+                                   imageHasContrast(*frame.cloud);
+  const bool restart = p.lost_frame_policy == LostFramePolicy::kReset ||
+                       lost_frames_ > p.max_lost_frames || tracks_out_of_reach;
   if (!restart) pose_ = lie::orthonormalized(reference_pose_ * update.motion);
   covariance_ = propagateCovariance(covariance_, previous.inverse() * pose_, guessed);
   update.pose = pose_;
@@ -1020,6 +1054,9 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // forgotten; a frame with too few points leaves no reference, so the next one starts anew.
     update.state = TrackingState::kReset;
     update.has_pose = p.lost_frame_policy != LostFramePolicy::kPublishNothing;
+    if (tracks_out_of_reach && lost_frames_ <= p.max_lost_frames) {
+      update.problem += "; restart: the second lost frame in a row whose tracks find no motion";
+    }
     // A new stretch starts here: its reference is no guess (the silent failure count judges no
     // pair across a restart).
     setReference(frame.cloud, update.stamp);
@@ -1035,7 +1072,7 @@ void KeyframeOdometry::lose(OdometryUpdate& update, const OdometryFrame& frame,
     // guess and no judge until the motion was 2 s in the past (a van crossing: 20 of 50 frames
     // lost, 4 restarts).
     const bool moving_lately = movedLately(frame.stamp);
-    if (!moving_lately || frames_since_anchor_ > p.max_lost_frames) {
+    if (!moving_lately || frames_since_anchor_ > p.max_lost_frames || tracks_out_of_reach) {
       tracksStartHere(update);
       // As a first frame: the stretch's origin is the frame the next ones' tracks start from
       // (priorFramePose), so they guess and judge at once; the last good frame before the

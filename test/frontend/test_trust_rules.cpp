@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include "cvo_odometry/core/keyframe_odometry.hpp"
 #include "cvo_odometry/core/lie_group.hpp"
@@ -164,6 +165,51 @@ TEST(TrustRules, NoTracksNoTrustAfterAFramePlacedByAGuess) {
   const cvo::OdometryUpdate checked =
       judged.process(odometryFrame(2 * kFrame, tum.frame(2), from_start));
   EXPECT_TRUE(checked.trusted()) << checked.problem;
+}
+
+// The second lost frame in a row whose tracks find no motion restarts tracking, and the next
+// frames' tracks start there, rather than frames being lost until max_lost_frames: tracks from
+// the last anchor, further away with every frame, would find none either. The first lost frame,
+// a second whose tracks still find the motion, and one without tracks at all (a hand over the
+// lens) stay lost.
+TEST(TrustRules, TheSecondLostFrameWhoseTracksFindNoMotionRestarts) {
+  TumTracked tum;
+  cvo::CvoParams slow = tum.params();
+  slow.max_linear_speed = 0.01;  // m/s: the camera moves 0.3 m/s here, so frames 1 and 2 are lost
+  ASSERT_GT(slow.max_lost_frames, 2);
+  enum class Tracks { kNone, kNoMotion, kReaching };
+  const auto run = [&](Tracks tracks) {
+    cvo::KeyframeOdometry odometry(tum.params());
+    odometry.process(odometryFrame(0.0, tum.frame(0), {}));
+    odometry.setParams(slow);
+    std::vector<cvo::OdometryUpdate> updates;
+    for (std::size_t k : {1, 2}) {
+      std::optional<cvo::MotionPrior> prior;
+      if (tracks != Tracks::kNone) {
+        prior = tum.prior(0, k);
+        prior->from_stamp = 0.0;
+        if (tracks == Tracks::kNoMotion) {
+          prior->solved = false;  // as PnP finding no motion among them
+          prior->problem = "no motion";
+        }
+      }
+      updates.push_back(
+          odometry.process(odometryFrame(static_cast<double>(k) * kFrame, tum.frame(k), prior)));
+    }
+    return updates;
+  };
+  const std::vector<cvo::OdometryUpdate> no_motion = run(Tracks::kNoMotion);
+  EXPECT_EQ(no_motion[0].state, cvo::TrackingState::kLost) << no_motion[0].problem;
+  EXPECT_FALSE(no_motion[0].restart_tracks);
+  ASSERT_EQ(no_motion[1].state, cvo::TrackingState::kReset) << no_motion[1].problem;
+  EXPECT_TRUE(no_motion[1].restart_tracks) << "the next frame's tracks start from the restart";
+  EXPECT_NE(no_motion[1].problem.find("restart: the second lost frame"), std::string::npos)
+      << no_motion[1].problem;
+  const cvo::MotionPrior two_steps = tum.prior(0, 2);
+  ASSERT_TRUE(two_steps.solved && two_steps.inliers >= tum.params().min_prior_inliers)
+      << two_steps.problem;
+  EXPECT_EQ(run(Tracks::kReaching)[1].state, cvo::TrackingState::kLost);
+  EXPECT_EQ(run(Tracks::kNone)[1].state, cvo::TrackingState::kLost);
 }
 
 }  // namespace

@@ -140,7 +140,8 @@ void visitSettings(CvoParams& p, V&& v) {
     p.max_angular_speed);
   v(SettingInfo{"lost_frame_policy", "tracking", "what a lost frame publishes"},
     p.lost_frame_policy);
-  v(SettingInfo{"max_lost_frames", "tracking", "lost frames in a row before tracking restarts", 0,
+  v(SettingInfo{"max_lost_frames", "tracking",
+                "lost frames in a row before tracking restarts (2 where tracks find no motion)", 0,
                 1000},
     p.max_lost_frames);
   // Keyframes

@@ -263,6 +263,8 @@ class KeyframeOdometry {
   // that refused a registration.
   std::optional<double> moving_seen_stamp_;
   std::optional<MotionSplit> split_;  // of the frame being processed, when it was split
+  // The frame being processed came with feature tracks (a prior), judging or not.
+  bool frame_has_tracks_ = false;
   // start <- the frame the processed frame's prior starts from (valid while it has one).
   Eigen::Isometry3d prior_frame_pose_ = Eigen::Isometry3d::Identity();
   // (lengthscale, F(X, X)) of reference_, and of the cloud being registered.
