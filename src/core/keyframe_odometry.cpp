@@ -598,19 +598,34 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   a.good = check.good;
   a.problems = check.problems;
   if (!a.good) return a;
+  // Something that moves is in view: a second motion or refused registrations lately, or
+  // pixels of the moving classes the labels left out (what they hide, the registration lacks).
+  const bool beside_moving = movedLately(frame.stamp) || frame.moving_classes_left_out;
   if (!priorJudges(frame.prior)) {
     // The cosine alone does not judge a registration to a lost frame (its motion may be right,
     // but the pose is the guess's times it) nor one beside an object moving through the view
     // (it scores a registration the object pulled like a right one): tracks must.
-    const bool moving_lately = movedLately(frame.stamp);
-    if (reference_guessed_ || moving_lately) {
+    if (reference_guessed_ || beside_moving) {
       a.good = false;
       a.problems = reference_guessed_
                        ? "no feature tracks to judge a registration to a frame placed by a guess"
                        : "no feature tracks to judge a registration while something moves in "
-                         "view (a second motion, or registrations the tracks refused, lately)";
+                         "view (moving classes left out, a second motion, or registrations the "
+                         "tracks refused, lately)";
       return a;
     }
+  }
+  const bool tracks_guess =
+      p.initial_guess == InitialGuess::kAuto || p.initial_guess == InitialGuess::kFeatures;
+  if (beside_moving && tracks_guess && guess.kind != GuessKind::kFeatures) {
+    // Started from standing still or the last velocity where the odometry starts from the
+    // tracks' motion: the tracks had none to offer, or the registration from theirs was refused.
+    // Beside something moving such a registration settles on the wrong motion too often (random
+    // cvo_make_dynamic cases: 7 of the 10 so trusted were silent failures).
+    a.good = false;
+    a.problems = "a registration from the " + toString(guess.kind) +
+                 " guess, not the feature tracks' motion, while something moves in view";
+    return a;
   }
   // The tracks' points are the previous frame's: the motion over this step is prior <- current.
   const Eigen::Isometry3d prior_from_reference = prior_frame_pose_.inverse() * reference_pose_;

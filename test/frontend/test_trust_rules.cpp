@@ -212,4 +212,40 @@ TEST(TrustRules, TheSecondLostFrameWhoseTracksFindNoMotionRestarts) {
   EXPECT_EQ(run(Tracks::kNone)[1].state, cvo::TrackingState::kLost);
 }
 
+// With the moving classes left out of a frame, something that moves is in view and what it hid
+// is missing from the registration: only the tracks judge it, and only a registration started
+// from their motion is trusted. Without tracks, or from the still guess (tracks that judge but
+// are too unsure to start from), the same frame 1 is trusted unlabelled and refused labelled.
+TEST(TrustRules, WithMovingClassesLeftOutOnlyARegistrationFromTheTracksIsTrusted) {
+  TumTracked tum;
+  const cvo::MotionPrior real = tum.prior(0, 1);
+  ASSERT_TRUE(real.solved) << real.problem;
+  cvo::MotionPrior unsure = real;
+  unsure.inlier_ratio = 0.5 * tum.params().min_prior_inlier_ratio;  // judges, guesses nothing
+  const auto run = [&](std::optional<cvo::MotionPrior> prior, bool labelled) {
+    cvo::KeyframeOdometry odometry(tum.params());
+    odometry.process(odometryFrame(0.0, tum.frame(0), {}));
+    cvo::OdometryFrame f = odometryFrame(kFrame, tum.frame(1), std::move(prior));
+    f.moving_classes_left_out = labelled;
+    return odometry.process(f);
+  };
+  for (const bool labelled : {false, true}) {
+    SCOPED_TRACE(labelled ? "labelled" : "unlabelled");
+    const cvo::OdometryUpdate from_tracks = run(real, labelled);
+    EXPECT_TRUE(from_tracks.trusted()) << from_tracks.problem;
+    EXPECT_EQ(from_tracks.guess, cvo::GuessKind::kFeatures);
+    const cvo::OdometryUpdate untracked = run(std::nullopt, labelled);
+    const cvo::OdometryUpdate still = run(unsure, labelled);
+    EXPECT_EQ(untracked.trusted(), !labelled) << untracked.problem;
+    EXPECT_EQ(still.trusted(), !labelled) << still.problem;
+    if (labelled) {
+      EXPECT_NE(untracked.problem.find("no feature tracks to judge"), std::string::npos)
+          << untracked.problem;
+      EXPECT_NE(still.problem.find("identity guess, not the feature tracks' motion"),
+                std::string::npos)
+          << still.problem;
+    }
+  }
+}
+
 }  // namespace
