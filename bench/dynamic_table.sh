@@ -24,13 +24,16 @@
 #   --check     exit 1 when a run of ours has a silent failure, a labelled run loses a frame, or
 #               an unlabelled run of one object up to a third of the image trusts fewer than two
 #               thirds of the frames
+#   --random N[,SEED]  instead of the named cases, N TUM and N/2 KITTI cases drawn at random
+#               (size, distance, velocity, with the camera or not, start, texture, shape; SEED 1:
+#               the same seed, the same cases on every machine): objects no rule was tuned on
 #   --no-peers  skip the OpenCV peers (they need bench/peer_build.sh's build: PCL, contrib)
 #   --tum, --kitti  the sequences (default: the bundled excerpts; KITTI: every frame there)
 #   --bin DIR   our tools (default: build/devel/lib/cvo_odometry)
 set -euo pipefail
 # shellcheck source=../scripts/env.sh
 source "$(dirname "$0")/../scripts/env.sh"
-quick=false more_cases=false check=false peers_on=true stride=1 first=0 drop=
+quick=false more_cases=false check=false peers_on=true stride=1 first=0 drop='' random=''
 tum=$CVO_ROOT/test/data/tum_fr1_xyz kitti=$CVO_ROOT/test/data/kitti_06_stereo
 bin=$CVO_BUILD/devel/lib/cvo_odometry
 while [ $# -gt 0 ]; do
@@ -42,10 +45,11 @@ while [ $# -gt 0 ]; do
     --drop) drop=${2:-}; [ $# -lt 2 ] || shift ;;
     --check) check=true ;;
     --no-peers) peers_on=false ;;
+    --random) random=${2:-}; [ $# -lt 2 ] || shift ;;
     --tum) tum=$2; shift ;;
     --kitti) kitti=$2; shift ;;
     --bin) bin=$2; shift ;;
-    *) sed -n '3,29p' "$0" >&2; exit 2 ;;
+    *) sed -n '3,32p' "$0" >&2; exit 2 ;;
   esac
   shift
 done
@@ -53,6 +57,8 @@ done
   { echo "dynamic_table: --stride takes a positive integer" >&2; exit 2; }
 [[ "$first" =~ ^[0-9]+$ ]] ||
   { echo "dynamic_table: --first takes a frame index (0 or more)" >&2; exit 2; }
+[ -z "$random" ] || [[ "$random" =~ ^[1-9][0-9]*(,[0-9]+)?$ ]] ||
+  { echo "dynamic_table: --random takes a case count and an optional seed (16,1)" >&2; exit 2; }
 [ "$stride" = 1 ] && [ "$first" = 0 ] && [ -z "$drop" ] || peers_on=false
 drop_args=()
 [ -z "$drop" ] || drop_args=(--drop "$drop")
@@ -118,6 +124,84 @@ if $more_cases; then
     "checkered truck along, leftward|kitti|--area 0.3 --depth 8 --with-camera --velocity -1,0,0 --start 0.55,0.6 --texture checker"
     "two: a car crossing, a van along in front|kitti|--area 0.08 --depth 15 --velocity -6,0,0 --start 0.7,0.6 --seed 5 + --area 0.16 --depth 9 --with-camera --velocity 1.9,0,0 --start 0.35,0.6"
   )
+fi
+
+if [ -n "$random" ]; then
+  # A linear congruential generator in shell arithmetic: the same seed draws the same cases
+  # whatever the machine's awk or shell random source.
+  draws=${random%%,*} lcg=1
+  [ "$draws" = "$random" ] || lcg=${random#*,}
+  uniform() {  # VAR LO HI DECIMALS: VAR set to a number drawn from [LO, HI]
+    lcg=$(((lcg * 1103515245 + 12345) % 2147483648))
+    printf -v "$1" '%s' "$(awk -v r="$lcg" -v lo="$2" -v hi="$3" -v d="$4" \
+      'BEGIN { printf("%." d "f", lo + (hi - lo) * r / 2147483648) }')"
+  }
+  pick() {  # VAR WORD...: VAR set to one of the words
+    local var=$1
+    shift
+    lcg=$(((lcg * 1103515245 + 12345) % 2147483648))
+    local words=("$@")
+    printf -v "$var" '%s' "${words[$(((lcg / 65536) % ${#words[@]}))]}"
+  }
+  # Ranges: TUM objects at 0.45-1.2 m covering 10-45 % of the image, walking (up to 0.6 m/s,
+  # any direction in the image, towards or away) or carried along with the camera (a fifth);
+  # KITTI vehicles at 6-20 m (a truck's third of the image at 8 m at most), crossing or
+  # oncoming, or driving along (half).
+  random_case() {  # KIND INDEX: the case in `drawn` (no subshell: the generator moves on)
+    local kind=$1 index=$2 area depth vx vy vz u v texture shape seed along name with=""
+    if [ "$kind" = tum ]; then
+      uniform area 0.1 0.45 2
+      uniform depth 0.45 1.2 2
+      uniform along 0 1 2
+      if awk -v a="$along" 'BEGIN { exit !(a < 0.2) }'; then
+        with="--with-camera "
+        uniform vx -0.15 0.15 2
+        uniform vy -0.05 0.05 2
+        uniform vz -0.05 0.05 2
+      else
+        uniform vx 0.05 0.6 2
+        pick vx "$vx" "-$vx"
+        uniform vy -0.15 0.15 2
+        uniform vz -0.3 0.3 2
+      fi
+      uniform u 0.15 0.85 2
+      uniform v 0.35 0.65 2
+    else
+      uniform depth 6 20 1
+      # A vehicle's size: up to a truck's third of the image at 8 m, less further away.
+      local largest
+      largest=$(awk -v z="$depth" 'BEGIN { a = 0.3 * (8 / z) ^ 2; print (a > 0.3 ? 0.3 : a) }')
+      uniform area 0.02 "$largest" 2
+      uniform along 0 1 2
+      vy=0
+      if awk -v a="$along" 'BEGIN { exit !(a < 0.5) }'; then
+        with="--with-camera "
+        uniform vx -2.5 2.5 1
+        uniform vz -3 3 1
+      else
+        uniform vx 2 10 1
+        pick vx "$vx" "-$vx"
+        uniform vz -8 2 1
+      fi
+      uniform u 0.2 0.8 2
+      uniform v 0.5 0.65 2
+    fi
+    pick texture plain stripes checker blocks scene
+    pick shape rect ellipse
+    uniform seed 1 99 0
+    name="random $kind $index: $texture $shape, $area of the image at $depth m, $vx,$vy,$vz m/s"
+    [ -z "$with" ] || name="$name with the camera"
+    drawn="$name|$kind|--area $area --depth $depth $with--velocity $vx,$vy,$vz --start $u,$v --texture $texture --shape $shape --seed $seed"
+  }
+  tum_cases=() kitti_cases=()
+  for ((k = 1; k <= draws; k++)); do
+    random_case tum "$k"
+    tum_cases+=("$drawn")
+  done
+  for ((k = 1; k <= draws / 2; k++)); do
+    random_case kitti "$k"
+    kitti_cases+=("$drawn")
+  done
 fi
 
 # "trusted/recovered/lost|mm|deg|silent" of a runner log.
