@@ -241,6 +241,11 @@ Eigen::Isometry3d KeyframeOdometry::stillMotion() const {
   return lie::orthonormalized(reference_pose_.inverse() * pose_);
 }
 
+bool KeyframeOdometry::priorGuesses() const {
+  return params().initial_guess == InitialGuess::kAuto ||
+         params().initial_guess == InitialGuess::kFeatures;
+}
+
 bool KeyframeOdometry::priorJudges(const std::optional<MotionPrior>& prior) const {
   return prior && prior->solved && prior->inliers >= params().min_prior_inliers;
 }
@@ -615,9 +620,7 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       return a;
     }
   }
-  const bool tracks_guess =
-      p.initial_guess == InitialGuess::kAuto || p.initial_guess == InitialGuess::kFeatures;
-  if (beside_moving && tracks_guess && guess.kind != GuessKind::kFeatures) {
+  if (beside_moving && priorGuesses() && guess.kind != GuessKind::kFeatures) {
     // Started from standing still or the last velocity where the odometry starts from the
     // tracks' motion: the tracks had none to offer, or the registration from theirs was refused.
     // Beside something moving such a registration settles on the wrong motion too often (random
@@ -860,9 +863,7 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
   // every point off the tracks by a few pixels, within what they allow. They register from the
   // tracks' motion: only where the prior may be a guess.
   const bool moving_lately = movedLately(frame.stamp);
-  const bool prior_guesses = params().initial_guess == InitialGuess::kAuto ||
-                             params().initial_guess == InitialGuess::kFeatures;
-  if (moving_lately && prior_guesses && priorConfident(frame.prior)) {
+  if (moving_lately && priorGuesses() && priorConfident(frame.prior)) {
     if (std::optional<Attempt> a = attemptWithConsistentPoints(*cloud, frame, update.dt)) {
       ++update.attempts;
       if (a->good) {

@@ -213,6 +213,8 @@ class KeyframeOdometry {
   void tracksStartHere(OdometryUpdate& update);
   // Enough inliers to contradict a registration, even at a ratio too low to be a guess.
   bool priorJudges(const std::optional<MotionPrior>& prior) const;
+  // initial_guess lets a confident feature prior's motion be where registrations start.
+  bool priorGuesses() const;
   // F(X, X) of the reference at `ell`, computed once per reference and lengthscale.
   double referenceSelfProduct(double ell);
   // A grid over the reference's points for consistency queries, built again only when
