@@ -558,6 +558,35 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   const CvoParams& p = params();
   Attempt a;
   a.guess = guess.kind;
+  // Rules on the frame and the guess alone, before the registration they would refuse.
+  // Something that moves is in view: a second motion or refused registrations lately, or
+  // pixels of the moving classes the labels left out (what they hide, the registration lacks).
+  const bool moving_lately = movedLately(frame.stamp);
+  const bool beside_moving = moving_lately || frame.moving_classes_left_out;
+  if (!priorJudges(frame.prior)) {
+    // The cosine alone does not judge a registration to a lost frame (its motion may be right,
+    // but the pose is the guess's times it) nor one beside an object moving through the view
+    // (it scores a registration the object pulled like a right one): tracks must.
+    if (reference_guessed_ || beside_moving) {
+      a.good = false;
+      a.problems = reference_guessed_
+                       ? "no feature tracks to judge a registration to a frame placed by a guess"
+                       : "no feature tracks to judge a registration while something moves in "
+                         "view (moving classes left out, a second motion, or registrations the "
+                         "tracks refused, lately)";
+      return a;
+    }
+  }
+  if (beside_moving && priorGuesses() && guess.kind != GuessKind::kFeatures) {
+    // Started from standing still or the last velocity where the odometry starts from the
+    // tracks' motion: the tracks had none to offer, or the registration from theirs was refused.
+    // Beside something moving such a registration settles on the wrong motion too often (random
+    // cvo_make_dynamic cases: 7 of the 10 so trusted were silent failures).
+    a.good = false;
+    a.problems = "a registration from the " + toString(guess.kind) +
+                 " guess, not the feature tracks' motion, while something moves in view";
+    return a;
+  }
   // Without a motion guess the registration needs the wide first-frame lengthscale; a confident
   // feature prior is millimetres off and needs no wide basin.
   {
@@ -603,33 +632,6 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
   a.good = check.good;
   a.problems = check.problems;
   if (!a.good) return a;
-  // Something that moves is in view: a second motion or refused registrations lately, or
-  // pixels of the moving classes the labels left out (what they hide, the registration lacks).
-  const bool beside_moving = movedLately(frame.stamp) || frame.moving_classes_left_out;
-  if (!priorJudges(frame.prior)) {
-    // The cosine alone does not judge a registration to a lost frame (its motion may be right,
-    // but the pose is the guess's times it) nor one beside an object moving through the view
-    // (it scores a registration the object pulled like a right one): tracks must.
-    if (reference_guessed_ || beside_moving) {
-      a.good = false;
-      a.problems = reference_guessed_
-                       ? "no feature tracks to judge a registration to a frame placed by a guess"
-                       : "no feature tracks to judge a registration while something moves in "
-                         "view (moving classes left out, a second motion, or registrations the "
-                         "tracks refused, lately)";
-      return a;
-    }
-  }
-  if (beside_moving && priorGuesses() && guess.kind != GuessKind::kFeatures) {
-    // Started from standing still or the last velocity where the odometry starts from the
-    // tracks' motion: the tracks had none to offer, or the registration from theirs was refused.
-    // Beside something moving such a registration settles on the wrong motion too often (random
-    // cvo_make_dynamic cases: 7 of the 10 so trusted were silent failures).
-    a.good = false;
-    a.problems = "a registration from the " + toString(guess.kind) +
-                 " guess, not the feature tracks' motion, while something moves in view";
-    return a;
-  }
   // The tracks' points are the previous frame's: the motion over this step is prior <- current.
   const Eigen::Isometry3d prior_from_reference = prior_frame_pose_.inverse() * reference_pose_;
   const Eigen::Isometry3d registered = a.result.transform;
@@ -675,7 +677,6 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     a.track_rotation_gap_deg = angleDeg(gapToTracks(*frame.prior, a.result.transform));
     // Beside something moving the dense stages may be pulled a little off the tracks, too
     // little for the pixel bound yet enough for a wrong pose: more of the tracks must agree.
-    const bool moving_lately = movedLately(frame.stamp);
     const double needed = moving_lately ? std::max(p.min_track_agreement, p.moving_track_agreement)
                                         : p.min_track_agreement;
     // With the moving classes left out of this frame, what could pull the dense stages is gone
