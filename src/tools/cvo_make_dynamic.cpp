@@ -34,7 +34,8 @@ const char* kUsage =
     "  such a folder, a second object, the first one's labels kept where it leaves them in view\n"
     "  --area F            share of the image it covers in the first frame (0.3)\n"
     "  --aspect A          width / height (0.75)\n"
-    "  --depth Z           metres from the first camera (0.6)\n"
+    "  --depth Z           metres from the first camera (0.6); TUM: the scene hides it where\n"
+    "                      nearer (its recorded depth); KITTI: painted over the scene\n"
     "  --start U,V         its centre in the first image, fractions of width and height "
     "(0.25,0.5)\n"
     "  --velocity X,Y,Z    m/s in the first camera's axes (x right, y down, z forward; "
@@ -162,15 +163,18 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
     sequence.load(k, &image, &depth);
     // Colour and labels at the colour image's time, depth at the depth image's: each shows the
     // object where it was when that image was taken.
+    // The recorded scene hides the object where it is nearer.
+    cv::Mat scene_depth;
+    depth.convertTo(scene_depth, CV_32FC1, 1.0 / kUnitsPerMetre);
     cv::Mat mask;
     cv::Mat painted = labels_only ? image.clone() : image;  // a scratch canvas for labels only
     object.render(object.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp, max_gap)),
-                  &painted, nullptr, &mask);
+                  &painted, nullptr, &mask, 0.0, &scene_depth);
     if (!labels_only) {
       cv::Mat object_depth;
       cv::Mat depth_image = image.clone();  // a scratch canvas; only the depth is kept
       object.render(object.cameraFromObject(f.depth_stamp, poseAt(truth, f.depth_stamp, max_gap)),
-                    &depth_image, &object_depth, nullptr);
+                    &depth_image, &object_depth, nullptr, 0.0, &scene_depth);
       for (int v = 0; v < depth.rows; ++v) {
         for (int u = 0; u < depth.cols; ++u) {
           const float z = object_depth.at<float>(v, u);

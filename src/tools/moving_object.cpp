@@ -155,7 +155,8 @@ Eigen::Isometry3d MovingObject::cameraFromObject(double stamp,
 }
 
 int MovingObject::render(const Eigen::Isometry3d& camera_from_object, cv::Mat* image,
-                         cv::Mat* depth, cv::Mat* mask, double shift_x) const {
+                         cv::Mat* depth, cv::Mat* mask, double shift_x,
+                         const cv::Mat* scene_depth) const {
   if (image == nullptr || image->rows != intrinsics_.height || image->cols != intrinsics_.width ||
       image->depth() != CV_8U || (image->channels() != 1 && image->channels() != 3)) {
     throw std::invalid_argument("the image must be 8-bit BGR or grey of the intrinsics' size");
@@ -168,6 +169,9 @@ int MovingObject::render(const Eigen::Isometry3d& camera_from_object, cv::Mat* i
     if (depth->size() != image->size() || depth->type() != CV_32FC1) {
       throw std::invalid_argument("the depth must be CV_32FC1 of the image's size");
     }
+  }
+  if (scene_depth && (scene_depth->size() != image->size() || scene_depth->type() != CV_32FC1)) {
+    throw std::invalid_argument("the scene depth must be CV_32FC1 of the image's size");
   }
   if (mask) *mask = cv::Mat::zeros(image->size(), CV_8UC1);
   // The ray x = s * (r, 1) from the camera at (shift_x, 0, 0), in the board's frame.
@@ -183,6 +187,10 @@ int MovingObject::render(const Eigen::Isometry3d& camera_from_object, cv::Mat* i
       if (std::abs(direction.z()) < 1e-9) continue;
       const double s = -origin.z() / direction.z();  // the camera's depth of the hit
       if (!(s > 1e-3)) continue;
+      if (scene_depth) {
+        const float z = scene_depth->at<float>(v, u);
+        if (std::isfinite(z) && z > 0.0f && z < s) continue;  // the scene is in front
+      }
       const Eigen::Vector3d hit = origin + s * direction;
       const double a = hit.x() / width_ + 0.5, b = hit.y() / height_ + 0.5;
       if (spec_.ellipse) {

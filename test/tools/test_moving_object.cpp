@@ -286,9 +286,9 @@ cvo_test::CommandOutput makeDynamic(const fs::path& source, const fs::path& out,
 
 // Proves: cvo_make_dynamic --tum writes rgb/, depth/, labels/rgb/, the three listings,
 // groundtruth.txt and object.txt for every frame; colour, labels and depth are the board
-// rendered at each image's own stamp (the depth in TUM's units, the scene's depth elsewhere
-// untouched); and cvo_run_sequence reads the folder with --segmentation (and needs the labels:
-// one removed, it stops).
+// rendered at each image's own stamp, hidden where the scene is nearer (the depth in TUM's units,
+// the scene's depth elsewhere untouched); and cvo_run_sequence reads the folder with --segmentation
+// (and needs the labels: one removed, it stops).
 TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
   const fs::path out = freshFolder("tum");
   const cvo_test::CommandOutput made =
@@ -323,9 +323,11 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
     ASSERT_EQ(labels.type(), CV_8UC1);
     // Colour and labels: the board at the colour image's stamp.
     source.load(k, &image, &raw);
+    cv::Mat scene_depth;
+    raw.convertTo(scene_depth, CV_32FC1, 1.0 / 5000.0);
     cv::Mat mask;
     board.render(board.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp)), &image, nullptr,
-                 &mask);
+                 &mask, 0.0, &scene_depth);
     EXPECT_EQ(cv::countNonZero((labels == 1) != (mask != 0)), 0) << "labels are the mask";
     EXPECT_EQ(cv::countNonZero(labels > 1), 0);
     cv::Mat diff;
@@ -334,7 +336,7 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
     // Depth: the board's at the depth image's stamp, in units of 1/5000 m; the scene's elsewhere.
     cv::Mat board_depth, scratch = image.clone();
     board.render(board.cameraFromObject(f.depth_stamp, poseAt(truth, f.depth_stamp)), &scratch,
-                 &board_depth, nullptr);
+                 &board_depth, nullptr, 0.0, &scene_depth);
     int wrong_board = 0, wrong_scene = 0, on_board = 0;
     for (int v = 0; v < raw.rows; ++v) {
       for (int u = 0; u < raw.cols; ++u) {
@@ -366,6 +368,63 @@ TEST(MakeDynamic, TumLayoutIsWhatTheDocumentationSaysAndTheRunnerReadsIt) {
   const cvo_test::CommandOutput missing = cvo_test::runCommand(runner);
   EXPECT_NE(missing.status, 0) << missing.output;
   EXPECT_NE(missing.output.find("no segmentation image"), std::string::npos) << missing.output;
+  fs::remove_all(out);
+}
+
+// Proves: a board farther than part of the recorded scene is hidden there, as a camera would see
+// it: where the recorded depth is nearer than the board, the colour, the depth and the labels are
+// the recorded frame's (class 0); where it is farther or unknown, they are the board's. Painted
+// over everything, the board's far depth over near scene points would be a view no camera gives.
+TEST(MakeDynamic, TheSceneHidesABoardBehindIt) {
+  const fs::path out = freshFolder("behind");
+  const cvo_test::CommandOutput made = makeDynamic(
+      kTum, out, "--area 0.6 --depth 1.1 --velocity 0,0,0 --start 0.5,0.5 --texture checker");
+  ASSERT_EQ(made.status, 0) << made.output;
+  const cvo::TumSequence source(kTum.string()), made_sequence(out.string());
+  cvo::MovingObjectSpec spec;
+  spec.area = 0.6;
+  spec.depth = 1.1;
+  spec.velocity = Eigen::Vector3d::Zero();
+  spec.start_u = spec.start_v = 0.5;
+  spec.texture = cvo::ObjectTexture::kChecker;
+  const TumBoard placed = tumBoard(source, spec);
+  const cvo::TumFramePaths& f = source.frames()[0];
+  cv::Mat image, raw, made_image, made_depth;
+  source.load(0, &image, &raw);
+  made_sequence.load(0, &made_image, &made_depth);
+  const cv::Mat labels = cv::imread((out / "labels" / f.rgb_listed).string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(labels.type(), CV_8UC1);
+  // The whole board, nothing hidden, at the colour and the depth image's stamps; counted where
+  // both show it (the camera moves between them), and not within 2 cm of the scene's depth.
+  const cvo::MovingObject& board = placed.board;
+  cv::Mat board_depth, colour_mask, scratch = image.clone();
+  board.render(board.cameraFromObject(f.depth_stamp, poseAt(placed.truth, f.depth_stamp)), &scratch,
+               &board_depth, nullptr);
+  board.render(board.cameraFromObject(f.rgb_stamp, poseAt(placed.truth, f.rgb_stamp)), &scratch,
+               nullptr, &colour_mask);
+  int hidden = 0, hidden_wrong = 0, shown = 0, shown_wrong = 0;
+  for (int v = 0; v < raw.rows; ++v) {
+    for (int u = 0; u < raw.cols; ++u) {
+      const float z = board_depth.at<float>(v, u);
+      if (!std::isfinite(z) || colour_mask.at<uchar>(v, u) == 0) continue;
+      const int recorded = raw.at<std::uint16_t>(v, u);
+      const float scene = recorded / 5000.0f;
+      const bool same_colour = made_image.at<cv::Vec3b>(v, u) == image.at<cv::Vec3b>(v, u);
+      if (recorded > 0 && scene < z - 0.02f) {
+        ++hidden;
+        hidden_wrong += made_depth.at<std::uint16_t>(v, u) != recorded ||
+                        labels.at<uchar>(v, u) != 0 || !same_colour;
+      } else if (recorded == 0 || scene > z + 0.02f) {
+        ++shown;
+        shown_wrong += std::abs(made_depth.at<std::uint16_t>(v, u) - z * 5000.0f) > 0.51f ||
+                       labels.at<uchar>(v, u) != 1;
+      }
+    }
+  }
+  EXPECT_GT(hidden, 20000) << "the scene is nearer than the board over a part of it";
+  EXPECT_GT(shown, 20000);
+  EXPECT_EQ(hidden_wrong, 0) << "of " << hidden;
+  EXPECT_EQ(shown_wrong, 0) << "of " << shown;
   fs::remove_all(out);
 }
 

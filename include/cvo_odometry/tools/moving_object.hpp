@@ -5,8 +5,9 @@
 // dataset's ground truth places it in each frame) or with the camera (a car driving along: its
 // image motion is only its drift). It is rendered by casting each pixel's ray (undistorted with
 // the camera's model) onto the board, so a stereo pair's two images, and an RGB-D frame's colour
-// and depth at their own stamps, show it consistently. It is painted over the scene: choose a
-// depth nearer than what it should hide.
+// and depth at their own stamps, show it consistently. Given the scene's depth (an RGB-D frame's),
+// the scene hides it where the scene is nearer, as a real camera would see it; without (a stereo
+// pair), it is painted over the scene: choose a depth nearer than what it should hide.
 #pragma once
 
 #include <string>
@@ -63,9 +64,10 @@ class MovingObject {
   // Paints the board seen from `camera_from_object` into `image` (8-bit BGR or grey), writes its
   // depth (m) into `depth` (CV_32FC1, may be null) and its mask into `mask` (CV_8UC1 255 where
   // it is, may be null). `shift_x`: a camera displaced by that much along its x axis (a stereo
-  // rig's right camera: +baseline). Returns the pixels it covers.
+  // rig's right camera: +baseline). `scene_depth` (CV_32FC1, m; 0 or not finite where unknown,
+  // may be null): the board is left out where the scene is nearer. Returns the pixels it covers.
   int render(const Eigen::Isometry3d& camera_from_object, cv::Mat* image, cv::Mat* depth,
-             cv::Mat* mask, double shift_x = 0.0) const;
+             cv::Mat* mask, double shift_x = 0.0, const cv::Mat* scene_depth = nullptr) const;
 
   // The labels of a frame whose object mask is `mask`: spec.label where the (eroded or dilated)
   // mask is, 0 elsewhere, 8-bit.
