@@ -18,6 +18,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cvo_odometry/core/trajectory_io.hpp"
+#include "cvo_odometry/frontend/depth_conversion.hpp"
 #include "cvo_odometry/frontend/kitti_sequence.hpp"
 #include "cvo_odometry/frontend/tum_sequence.hpp"
 #include "cvo_odometry/tools/command_line.hpp"
@@ -164,8 +165,7 @@ void makeTum(const cvo::CommandLine& cli, const cvo::MovingObjectSpec& spec, con
     // Colour and labels at the colour image's time, depth at the depth image's: each shows the
     // object where it was when that image was taken.
     // The recorded scene hides the object where it is nearer.
-    cv::Mat scene_depth;
-    depth.convertTo(scene_depth, CV_32FC1, 1.0 / kUnitsPerMetre);
+    const cv::Mat scene_depth = cvo::depthToMetres(depth, kUnitsPerMetre, 0.0, INFINITY);
     cv::Mat mask;
     cv::Mat painted = labels_only ? image.clone() : image;  // a scratch canvas for labels only
     object.render(object.cameraFromObject(f.rgb_stamp, poseAt(truth, f.rgb_stamp, max_gap)),
