@@ -108,6 +108,7 @@ void CvoParams::validate() const {
           "motion_split_depth_ratio must be in [1, 100]");
   require(tracked_cosine_ratio >= 0.0 && tracked_cosine_ratio <= 1.0,
           "tracked_cosine_ratio must be in [0, 1]");
+  require(weak_cosine >= 0.0 && weak_cosine <= 1.0, "weak_cosine must be in [0, 1]");
   requirePositive(photometric_max_correction, "photometric_max_correction");
 }
 

@@ -30,6 +30,12 @@ constexpr double kMovingMemorySeconds = 2.0;
 // and a turn up to this times max_track_rotation_gap from the tracks' is the tracks' error.
 constexpr double kLeftOutSpreadFactor = 2.0;
 static_assert(kLeftOutSpreadFactor == 2.0, "the turn check's indicator says \"twice\"");
+// A side of an undecided split kept by less than this share of the best-kept side's rate is
+// gone from a later frame's inliers.
+constexpr double kOneSideShare = 0.25;
+// Below weak_cosine a registration's tracks must lie within this share of track_agreement_px
+// (median).
+constexpr double kWeakCosineTrackShare = 0.6;
 // The constant-velocity prediction's error is judged over this many trusted frames, once it has
 // at least kPredictionHistoryMin of them.
 constexpr std::size_t kPredictionHistory = 10;
@@ -136,6 +142,7 @@ KeyframeOdometry::KeyframeOdometry(const CvoParams& params,
 
 void KeyframeOdometry::reset(const Eigen::Isometry3d& base_pose) {
   moving_seen_stamp_.reset();
+  undecided_split_.reset();
   reference_.reset();
   reference_guessed_ = false;
   last_good_.reset();
@@ -314,7 +321,13 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
     split_ = splitMotions(*frame.prior, params().motion_split_depth_ratio,
                           params().motion_split_ratio, predicted, prediction_error_px);
   }
-  if (split_->scene == SceneMotion::kUndecided) return split_->why;
+  if (split_->scene == SceneMotion::kUndecided) {
+    if (std::isfinite(frame.prior->from_stamp)) {
+      undecided_split_ =
+          UndecidedSplit{frame.prior->from_stamp, frame.prior->tracked_points, split_->owner};
+    }
+    return split_->why;
+  }
   const std::string behind = judgeSceneBehind(frame, split_->scene == SceneMotion::kSecond);
   if (!behind.empty()) return behind;
   MotionPrior scene = sceneFirst(*frame.prior, *split_);
@@ -333,6 +346,16 @@ std::string KeyframeOdometry::judgeSecondMotion(OdometryFrame& frame) {
   frame.prior = std::move(scene);
   frame.cloud = std::move(rest);
   return "";
+}
+
+std::string KeyframeOdometry::oneSideOfUndecidedSplit(const OdometryFrame& frame) const {
+  // Only a frame without a split of its own: one it decided speaks for itself.
+  if (!undecided_split_ || !frame.prior || split_ ||
+      frame.prior->from_stamp != undecided_split_->from_stamp) {
+    return "";
+  }
+  return cvo::oneSideOfUndecidedSplit(undecided_split_->points, undecided_split_->owner,
+                                      *frame.prior, params().min_prior_inliers, kOneSideShare);
 }
 
 std::shared_ptr<const LabeledCloud> KeyframeOdometry::withoutRegion(
@@ -677,8 +700,10 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
     a.track_rotation_gap_deg = angleDeg(gapToTracks(*frame.prior, a.result.transform));
     // Beside something moving the dense stages may be pulled a little off the tracks, too
     // little for the pixel bound yet enough for a wrong pose: more of the tracks must agree.
-    const double needed = moving_lately ? std::max(p.min_track_agreement, p.moving_track_agreement)
-                                        : p.min_track_agreement;
+    // Before a frame since the start is trusted nothing tells whether something moves in view.
+    const bool moving_unknown = moving_lately || !trusted_since_start_;
+    const double needed = moving_unknown ? std::max(p.min_track_agreement, p.moving_track_agreement)
+                                         : p.min_track_agreement;
     // With the moving classes left out of this frame, what could pull the dense stages is gone
     // from them, and the tracks see only the rest of the view, whose turn they fix less well:
     // over 102 labelled runs of cvo_make_dynamic cases (strides 1-3) the doubled bound keeps 30
@@ -702,11 +727,22 @@ KeyframeOdometry::Attempt KeyframeOdometry::attempt(const LabeledCloud& cloud, c
       why << "feature tracks disagree: " << 100.0 * a.agreement << " % of "
           << frame.prior->points.size() << " inlier tracks within " << p.track_agreement_px
           << " px (median error " << a.track_error_px << " px; they moved " << a.track_flow_px
-          << " px) < " << (moving_lately ? "moving_track_agreement " : "min_track_agreement ")
+          << " px) < " << (moving_unknown ? "moving_track_agreement " : "min_track_agreement ")
           << needed;
       a.good = false;
       a.problems = why.str();
       moving_seen_stamp_ = frame.stamp;
+    } else if (a.cosine < p.weak_cosine &&
+               a.track_error_px > kWeakCosineTrackShare * p.track_agreement_px) {
+      // Two weak signs, each common alone in right frames (weak_cosine); together they mark
+      // registrations that settled most of a step off.
+      std::ostringstream why;
+      why.precision(3);
+      why << "weak alignment (cosine " << a.cosine << " < weak_cosine " << p.weak_cosine
+          << ") and the feature tracks miss the pose by a median " << a.track_error_px << " px (> "
+          << kWeakCosineTrackShare << " track_agreement_px)";
+      a.good = false;
+      a.problems = why.str();
     } else if (a.photometric.tracks > 0) {
       // The stage's pose must agree with the tracks too: intensities that dragged it off them
       // (the translation has no bound of its own) give way to CVO's pose.
@@ -839,6 +875,12 @@ OdometryUpdate KeyframeOdometry::process(OdometryFrame frame) {
     lose(update, frame, split_problem);
     return update;
   }
+  if (const std::string side = oneSideOfUndecidedSplit(frame); !side.empty()) {
+    moving_seen_stamp_ = frame.stamp;
+    frame.prior.reset();
+    lose(update, frame, side);
+    return update;
+  }
   std::vector<Guess> first, retries;
   chooseGuesses(frame, update.frame_interval, &first, &retries);
   std::optional<Attempt> chosen;
@@ -944,6 +986,7 @@ OdometryUpdate KeyframeOdometry::startFrom(const OdometryFrame& frame) {
   const std::shared_ptr<const LabeledCloud>& cloud = frame.cloud;
   OdometryUpdate update;
   tracksStartHere(update);
+  trusted_since_start_ = false;
   update.stamp = frame.stamp;
   update.state = TrackingState::kFirstFrame;
   update.pose = pose_;
@@ -1019,6 +1062,7 @@ void KeyframeOdometry::accept(OdometryUpdate& update, Attempt& chosen, const Odo
   }
   last_trusted_pose_ = pose_;
   last_trusted_stamp_ = update.stamp;
+  trusted_since_start_ = true;
   lost_frames_ = 0;
   frames_since_anchor_ = 0;
   if (!reference_first_cosine_) reference_first_cosine_ = update.cosine;

@@ -288,6 +288,50 @@ bool thirdMotionSeparate(const MotionPrior& prior, int min_tracks, double moving
          motionsApartPx(prior, prior.second.motion, prior.third.motion) >= apart;
 }
 
+std::string oneSideOfUndecidedSplit(
+    const std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>>& split_points,
+    const std::vector<int>& owner, const MotionPrior& now, int min_tracks,
+    double other_side_share) {
+  const std::size_t n = std::min(split_points.size(), owner.size());
+  int sides = 0;
+  for (std::size_t k = 0; k < n; ++k)
+    sides = std::max(sides, owner[k] + 1);
+  if (sides < 2) return "";
+  // Of each side's tracks, those among the inliers now: the same start points, since the tracks
+  // start from the same frame's corners.
+  std::vector<int> total(static_cast<std::size_t>(sides), 0), kept(total);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (owner[k] >= 0) ++total[static_cast<std::size_t>(owner[k])];
+  }
+  for (const Eigen::Vector3d& point : now.points) {
+    for (std::size_t k = 0; k < n; ++k) {
+      if (owner[k] >= 0 && (split_points[k] - point).squaredNorm() < 1e-12) {
+        ++kept[static_cast<std::size_t>(owner[k])];
+        break;
+      }
+    }
+  }
+  // The side kept at the highest rate (kept / total), compared without division.
+  std::size_t most = 0;
+  for (std::size_t side = 1; side < kept.size(); ++side) {
+    if (kept[side] * total[most] > kept[most] * total[side]) most = side;
+  }
+  if (kept[most] < min_tracks) return "";
+  for (std::size_t side = 0; side < kept.size(); ++side) {
+    if (side != most && kept[side] * total[most] >= other_side_share * kept[most] * total[side]) {
+      return "";
+    }
+  }
+  std::ostringstream why;
+  why << "its tracks follow one side of a split of motions the frame before could not decide ("
+      << kept[most] << " of that side's " << total[most] << " tracks";
+  for (std::size_t side = 0; side < kept.size(); ++side) {
+    if (side != most) why << ", " << kept[side] << " of the other's " << total[side];
+  }
+  why << ")";
+  return why.str();
+}
+
 std::string sceneBehindItsMotion(const MotionPrior& prior, bool scene_is_second, int min_tracks) {
   // Over the dynamic cases and the still sequences (strides 1-5, two start frames, about
   // 8,300 trusted frames), tracks following no motion at 1.5x the depth flagged 13 frames: 9

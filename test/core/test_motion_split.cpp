@@ -242,6 +242,53 @@ TEST(MotionSplit, TheObjectKnownFromTheLastFrameSettlesABalancedSplit) {
   EXPECT_EQ(against.scene, cvo::SceneMotion::kUndecided) << against.why;
 }
 
+// The prior of a later frame whose tracks start where `scene`'s do: as inliers, the first `keep`
+// tracks of each motion (truth 0 and 1), in the start frame's coordinates as the tracker gives
+// them.
+cvo::MotionPrior laterFrame(const Scene& scene, int keep_first, int keep_second) {
+  cvo::MotionPrior later;
+  int kept[2] = {0, 0};
+  const int keep[2] = {keep_first, keep_second};
+  for (std::size_t k = 0; k < scene.truth.size(); ++k) {
+    const int side = scene.truth[k];
+    if (kept[side] >= keep[side]) continue;
+    ++kept[side];
+    later.points.push_back(scene.prior.tracked_points[k]);
+  }
+  return later;
+}
+
+// Proves: after a balanced split left undecided, a later frame whose inliers keep one side's
+// tracks and hardly any of the other's follows that side, whose motion is the scene's as likely
+// as the object's: it is named, with each side's count. Both sides kept alike (the motions agree
+// now), too few kept, or tracks that start elsewhere (another start frame) say nothing.
+TEST(MotionSplit, AFrameKeepingOneSideOfAnUndecidedSplitIsNamed) {
+  const Scene balanced = similarDepths(60, 50);
+  const cvo::MotionSplit s = split(balanced.prior);
+  ASSERT_EQ(s.scene, cvo::SceneMotion::kUndecided) << s.why;
+  const auto& points = balanced.prior.tracked_points;
+  const int min_tracks = kParams.min_prior_inliers;
+  const auto judge = [&](const cvo::MotionPrior& later) {
+    return cvo::oneSideOfUndecidedSplit(points, s.owner, later, min_tracks, 0.25);
+  };
+
+  const std::string second_side = judge(laterFrame(balanced, 2, 45));
+  EXPECT_NE(second_side.find("one side"), std::string::npos) << second_side;
+  EXPECT_NE(second_side.find("45 of that side's 50 tracks, 2 of the other's 60"), std::string::npos)
+      << second_side;
+  EXPECT_FALSE(judge(laterFrame(balanced, 55, 3)).empty());
+  // Both sides at similar rates, or the other side at a quarter of the first's rate: alike.
+  EXPECT_EQ(judge(laterFrame(balanced, 40, 30)), "");
+  EXPECT_EQ(judge(laterFrame(balanced, 60, 13)), "");
+  // One side, but fewer than min_prior_inliers of it.
+  EXPECT_EQ(judge(laterFrame(balanced, 0, min_tracks - 1)), "");
+  // Tracks from another start frame's corners match none of the split's.
+  cvo::MotionPrior elsewhere = laterFrame(balanced, 0, 45);
+  for (Eigen::Vector3d& p : elsewhere.points)
+    p.x() += 0.01;
+  EXPECT_EQ(judge(elsewhere), "");
+}
+
 // Proves: occlusion that contradicts the depths by far leaves the split undecided. A truck
 // (8 m, most tracks) driving along, the road just below it (6 m, the camera's motion: nearer, so
 // "in front" of the truck's tracks it neighbours) and the background far away (40 m, beyond the

@@ -166,10 +166,17 @@ struct CvoParams {
   // something the tracks do not follow.
   double max_track_rotation_gap = 0.5;
   // ... and while something moved in view lately (a second motion of its own, or registrations
-  // the tracks refused, within 2 s), at least this fraction of them must agree.
+  // the tracks refused, within 2 s), or before a frame since the start is trusted (nothing
+  // tells yet whether something moves), at least this fraction of them must agree.
   double moving_track_agreement = 0.9;
   // ... and a registration the tracks judge needs a cosine of only this fraction of min_cosine.
   double tracked_cosine_ratio = 0.25;
+  // ... and one scoring below weak_cosine needs its tracks within a median of 0.6
+  // track_agreement_px of its pose (0: no such bound). Each sign alone is common in right frames
+  // (an RGB-D camera's tracks miss a right pose by 6-9 px where their depth is older than their
+  // colour; a keyframe some steps back scores a low cosine), the two together are not. Stereo's
+  // cosine falls with range: its preset has none.
+  double weak_cosine = 0.7;
   // An object moving through the view shows as a second motion among the tracks (MotionPrior::
   // second). One of min_prior_inliers tracks that moves them at least moving_min_px from where
   // the first puts them is a motion of its own: the scene is the farther tracks' motion when

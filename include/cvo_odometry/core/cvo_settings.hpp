@@ -194,8 +194,9 @@ void visitSettings(CvoParams& p, V&& v) {
                 0.001, 180.0},
     p.max_track_rotation_gap);
   v(SettingInfo{"moving_track_agreement", "moving",
-                "while something moved in view lately, this fraction of the tracks must agree "
-                "with a registration (at least min_track_agreement)",
+                "while something moved in view lately, and until a frame since the start is "
+                "trusted, this fraction of the tracks must agree with a registration (at least "
+                "min_track_agreement)",
                 0.0, 1.0},
     p.moving_track_agreement);
   v(SettingInfo{"tracked_cosine_ratio", "tracking",
@@ -203,6 +204,11 @@ void visitSettings(CvoParams& p, V&& v) {
                 "min_cosine",
                 0.0, 1.0},
     p.tracked_cosine_ratio);
+  v(SettingInfo{"weak_cosine", "tracking",
+                "a registration below this cosine is trusted only if the tracks' median error is "
+                "within 0.6 track_agreement_px (0: no such bound)",
+                0.0, 1.0},
+    p.weak_cosine);
   v(SettingInfo{"moving_min_px", "moving",
                 "a second motion among the tracks that moves them at least this far (px) from "
                 "where the first puts them is an object moving on its own",

@@ -208,6 +208,10 @@ class KeyframeOdometry {
   // Why the scene may not follow the motion it is taken to (sceneBehindItsMotion), kept as an
   // undecided split; empty when nothing says so.
   std::string judgeSceneBehind(const OdometryFrame& frame, bool scene_is_second);
+  // Why a frame whose tracks start where those of an undecided split did cannot be trusted:
+  // its inliers are one side of that split (the other's tracks gone or refused), whose motion is
+  // the scene's as likely as the object's. Empty otherwise.
+  std::string oneSideOfUndecidedSplit(const OdometryFrame& frame) const;
   // The next frame's tracks start from this one (update.restart_tracks), and the frames since
   // their start are counted from it.
   void tracksStartHere(OdometryUpdate& update);
@@ -265,6 +269,15 @@ class KeyframeOdometry {
   // that refused a registration.
   std::optional<double> moving_seen_stamp_;
   std::optional<MotionSplit> split_;  // of the frame being processed, when it was split
+  bool trusted_since_start_ = false;  // a frame was trusted since the last (re)start
+  // The tracks of the last split left undecided, by their start points (the camera frame of
+  // the frame they start from) and the motion each followed (MotionSplit::owner).
+  struct UndecidedSplit {
+    double from_stamp = 0.0;
+    std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>> points;
+    std::vector<int> owner;
+  };
+  std::optional<UndecidedSplit> undecided_split_;
   // The frame being processed came with feature tracks (a prior), judging or not.
   bool frame_has_tracks_ = false;
   // start <- the frame the processed frame's prior starts from (valid while it has one).

@@ -73,6 +73,16 @@ MotionSplit splitThreeMotions(MotionPrior* prior, double depth_ratio, double lop
 // evidence does not say so.
 std::string sceneBehindItsMotion(const MotionPrior& prior, bool scene_is_second, int min_tracks);
 
+// Why a later frame's tracks cannot place it where an earlier frame's split of motions was left
+// undecided: `split_points` are that frame's tracked points (the start frame's corners, from which
+// `now`'s tracks start too) and `owner` their motion (MotionSplit::owner). When `now`'s inliers
+// keep at least `min_tracks` of one side's tracks and, of every other side, less than
+// `other_side_share` times that side's rate, they follow one side, whose motion is the scene's as
+// likely as the object's. Empty when the sides move alike (both kept) or too few are kept.
+std::string oneSideOfUndecidedSplit(
+    const std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>>& split_points,
+    const std::vector<int>& owner, const MotionPrior& now, int min_tracks, double other_side_share);
+
 // The prior as the scene sees it: the scene's motion first, its own tracks alone as the inliers
 // (those the other motion explains better left out), the other motion second with its own.
 MotionPrior sceneFirst(const MotionPrior& prior, const MotionSplit& split);
