@@ -58,12 +58,10 @@ class TumTracked {
   std::unique_ptr<cvo::RgbdCloudBuilder> builder_;
 };
 
-// The prior's motion turned by `degrees` about the camera's y axis, its tracks seen where that
+// The prior with `motion` (previous <- current) as its motion and its tracks seen where that
 // motion puts them: tracks as consistent as real ones, of a motion off the truth.
-cvo::MotionPrior turned(cvo::MotionPrior prior, double degrees) {
-  Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
-  turn.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
-  prior.motion = prior.motion * turn;
+cvo::MotionPrior seenBy(cvo::MotionPrior prior, const Eigen::Isometry3d& motion) {
+  prior.motion = motion;
   const Eigen::Isometry3d current_from_previous = prior.motion.inverse();
   for (std::size_t k = 0; k < prior.points.size(); ++k) {
     const Eigen::Vector3d p = current_from_previous * prior.points[k];
@@ -77,10 +75,16 @@ cvo::MotionPrior turned(cvo::MotionPrior prior, double degrees) {
   return prior;
 }
 
+// The prior's motion turned by `degrees` about the camera's y axis.
+cvo::MotionPrior turned(const cvo::MotionPrior& prior, double degrees) {
+  Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
+  turn.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+  return seenBy(prior, prior.motion * turn);
+}
+
 // The prior's motion moved sideways (the previous camera's x) so that its inlier tracks miss the
-// true motion by a median of `median_px`: tracks as consistent as real ones, of a motion off by a
-// centimetre or so.
-cvo::MotionPrior shifted(cvo::MotionPrior prior, double median_px) {
+// true motion by a median of `median_px`: a motion off by a centimetre or so.
+cvo::MotionPrior shifted(const cvo::MotionPrior& prior, double median_px) {
   std::vector<double> px_per_metre;
   for (const Eigen::Vector3d& point : prior.points)
     px_per_metre.push_back(prior.focal_px / point.z());
@@ -88,18 +92,7 @@ cvo::MotionPrior shifted(cvo::MotionPrior prior, double median_px) {
                    px_per_metre.end());
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation().x() = median_px / px_per_metre[px_per_metre.size() / 2];
-  prior.motion = shift * prior.motion;
-  const Eigen::Isometry3d current_from_previous = prior.motion.inverse();
-  for (std::size_t k = 0; k < prior.points.size(); ++k) {
-    const Eigen::Vector3d p = current_from_previous * prior.points[k];
-    prior.observations[k] = p.head<2>() / p.z();
-  }
-  for (std::size_t k = 0; k < prior.tracked_points.size(); ++k) {
-    const Eigen::Vector3d p = current_from_previous * prior.tracked_points[k];
-    prior.tracked_observations[k] = p.head<2>() / p.z();
-  }
-  prior.second = {};
-  return prior;
+  return seenBy(prior, shift * prior.motion);
 }
 
 cvo::OdometryFrame odometryFrame(double stamp, const Frame& frame,
